@@ -1,0 +1,4 @@
+//! directlab: Monte Carlo direct illumination and a harness that measures its convergence.
+
+pub mod rng;
+pub mod scene;

@@ -1,0 +1,182 @@
+//! Dialect-neutral scene description: what the XML readers produce and the renderer consumes.
+//!
+//! Everything here is already in world space (transforms applied, meshes loaded), so the
+//! renderer never needs to know which dialect a scene came from. `origin` strings name the file
+//! and line an element came from, so errors found later (degenerate emitters, ...) can point at it.
+
+use glam::{Mat4, Vec3};
+use std::path::PathBuf;
+
+/// Linear RGB triple used for colours, radiance and intensities.
+pub type Rgb = Vec3;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneDesc {
+    /// The XML file the scene was read from.
+    pub source: PathBuf,
+    pub camera: CameraDesc,
+    pub film: FilmDesc,
+    pub sampler: SamplerDesc,
+    pub integrator: IntegratorDesc,
+    pub shapes: Vec<ShapeDesc>,
+    pub point_lights: Vec<PointLightDesc>,
+    /// Non-fatal findings of the reader (ignored but harmless attributes, defaults applied
+    /// where Nori and Mitsuba differ, ...), printed by the CLI.
+    pub warnings: Vec<String>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FovAxis {
+    X,
+    Y,
+    Diagonal,
+    Smaller,
+    Larger,
+}
+
+/// Perspective pinhole camera. Camera space follows Mitsuba: looks along +z, +y is up and +x
+/// points to the image's left (so `lookat` gives the expected, unmirrored picture).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraDesc {
+    pub to_world: Mat4,
+    pub fov_degrees: f32,
+    pub fov_axis: FovAxis,
+    pub near_clip: f32,
+    pub far_clip: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FilterDesc {
+    Box,
+    /// Tent of the given radius in pixels (Mitsuba default 1).
+    Tent { radius: f32 },
+    /// Gaussian of the given standard deviation in pixels, truncated at `radius`
+    /// (Mitsuba 3: stddev 0.5, radius 4*stddev; Nori: stddev 0.5, radius 2).
+    Gaussian { stddev: f32, radius: f32 },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilmDesc {
+    pub width: u32,
+    pub height: u32,
+    pub filter: FilterDesc,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SamplerDesc {
+    pub sample_count: u32,
+    pub seed: u64,
+}
+
+/// How a direct-lighting estimator combines its techniques; scenes name one, the CLI may
+/// override it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StrategyKind {
+    /// BSDF sampling only (Nori `material`).
+    Bsdf,
+    /// Light sampling only (Nori `light`).
+    Light,
+    /// Multi-sample MIS of light and BSDF samples.
+    Mis,
+    /// One-sample MIS: each sample picks one technique at random.
+    MisOneSample,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Heuristic {
+    Balance,
+    Power,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct IntegratorDesc {
+    pub strategy: StrategyKind,
+    pub heuristic: Heuristic,
+    pub emitter_samples: u32,
+    pub bsdf_samples: u32,
+    pub hide_emitters: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MicrofacetDistribution {
+    Beckmann,
+    Ggx,
+}
+
+/// Materials as written in the scene. The renderer may reject ones it does not support yet.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BsdfDesc {
+    Diffuse {
+        reflectance: Rgb,
+    },
+    /// Mitsuba `twosided`: the nested BSDF is used on both sides of the surface.
+    TwoSided(Box<BsdfDesc>),
+    /// Smooth conductor (Mitsuba `conductor`; Nori `mirror` is eta=0,k=0 with full reflectance
+    /// and is represented as `Mirror`).
+    Conductor {
+        eta: Rgb,
+        k: Rgb,
+        specular_reflectance: Rgb,
+    },
+    RoughConductor {
+        distribution: MicrofacetDistribution,
+        alpha_u: f32,
+        alpha_v: f32,
+        sample_visible: bool,
+        eta: Rgb,
+        k: Rgb,
+        specular_reflectance: Rgb,
+    },
+    Dielectric {
+        int_ior: f32,
+        ext_ior: f32,
+    },
+    /// Nori `microfacet`: diffuse kd plus a Beckmann specular lobe with ks = 1 - max(kd).
+    NoriMicrofacet {
+        alpha: f32,
+        int_ior: f32,
+        ext_ior: f32,
+        kd: Rgb,
+    },
+    /// Nori `mirror`: perfect specular reflection with reflectance 1.
+    Mirror,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShapeGeometry {
+    /// Triangle mesh in world space. `normals`, when present, has one entry per vertex.
+    Mesh {
+        positions: Vec<Vec3>,
+        normals: Option<Vec<Vec3>>,
+        indices: Vec<[u32; 3]>,
+    },
+    /// Exact sphere in world space. `flip_normals` makes its normal point inwards.
+    Sphere {
+        center: Vec3,
+        radius: f32,
+        flip_normals: bool,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct AreaEmitterDesc {
+    /// One-sided constant radiance, emitted on the side the shape normal points to.
+    pub radiance: Rgb,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShapeDesc {
+    pub geometry: ShapeGeometry,
+    pub bsdf: BsdfDesc,
+    pub emitter: Option<AreaEmitterDesc>,
+    /// Where the shape was declared, as "file.xml:LINE <shape type=...>", for messages.
+    pub origin: String,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointLightDesc {
+    pub position: Vec3,
+    /// Radiant intensity in W/sr.
+    pub intensity: Rgb,
+    pub origin: String,
+}

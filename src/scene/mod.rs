@@ -1,0 +1,3 @@
+//! Scene loading: XML readers for Mitsuba 3, Mitsuba 0.6 and Nori, producing a `SceneDesc`.
+
+pub mod desc;
