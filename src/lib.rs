@@ -1,4 +1,16 @@
 //! directlab: Monte Carlo direct illumination and a harness that measures its convergence.
 
+// `!(x > 0.0)` is how this crate rejects NaN together with non-positive values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod bsdf;
+pub mod camera;
+pub mod emitter;
+pub mod film;
+pub mod geometry;
+pub mod integrator;
+pub mod math;
+pub mod render;
 pub mod rng;
+pub mod sampling;
 pub mod scene;

@@ -1,0 +1,86 @@
+//! Lambertian reflection, one-sided (black from behind unless wrapped in a two-sided material).
+
+use super::BsdfSample;
+use crate::math::{Rgb, INV_PI};
+use crate::sampling::warps::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Debug)]
+pub struct Diffuse {
+    pub reflectance: Rgb,
+}
+
+impl Diffuse {
+    #[inline]
+    pub fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return Rgb::ZERO;
+        }
+        self.reflectance * (INV_PI * wo.z)
+    }
+
+    #[inline]
+    pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+        if wi.z <= 0.0 {
+            return 0.0;
+        }
+        square_to_cosine_hemisphere_pdf(wo)
+    }
+
+    #[inline]
+    pub fn sample(&self, wi: Vec3, u: Vec2) -> Option<BsdfSample> {
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let wo = square_to_cosine_hemisphere(u);
+        let pdf = square_to_cosine_hemisphere_pdf(wo);
+        if pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wo,
+            weight: self.reflectance,
+            pdf,
+            delta: false,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::*;
+    use super::super::*;
+
+    fn diffuse(two_sided: bool) -> Material {
+        Material {
+            kind: BsdfKind::Diffuse(Diffuse {
+                reflectance: Rgb::new(0.2, 0.5, 0.9),
+            }),
+            two_sided,
+        }
+    }
+
+    #[test]
+    fn sample_eval_pdf_agree() {
+        check_sample_consistency(&diffuse(false), 20_000);
+        check_sample_consistency(&diffuse(true), 20_000);
+    }
+
+    #[test]
+    fn albedo_equals_reflectance() {
+        let wi = Vec3::new(0.3, 0.1, 0.8).normalize();
+        let (a, _) = albedo(&diffuse(false), wi, 10_000);
+        assert!((a - Rgb::new(0.2, 0.5, 0.9)).abs().max_element() < 1e-5);
+    }
+
+    #[test]
+    fn one_sided_is_black_from_behind_two_sided_is_not() {
+        let wi = Vec3::new(0.0, 0.0, -1.0);
+        let wo = Vec3::new(0.0, 0.6, -0.8);
+        assert_eq!(diffuse(false).eval(wi, wo), Rgb::ZERO);
+        assert!(diffuse(false).sample(wi, 0.5, Vec2::splat(0.5)).is_none());
+        assert!(diffuse(true).eval(wi, wo).x > 0.0);
+        let s = diffuse(true).sample(wi, 0.5, Vec2::splat(0.3)).unwrap();
+        assert!(s.wo.z < 0.0);
+    }
+}

@@ -1,0 +1,144 @@
+//! BSDFs in the local shading frame (z = shading normal), with `sample`, `eval` and `pdf`
+//! that agree: `sample` returns weight = eval / pdf for the direction it drew.
+//!
+//! Conventions (as Mitsuba): `wi` is the direction towards the viewer/previous vertex,
+//! `wo` the sampled direction towards the light; `eval` includes the |cos| of `wo`.
+
+mod diffuse;
+
+pub use diffuse::Diffuse;
+
+use crate::math::Rgb;
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    pub wo: Vec3,
+    /// eval(wi, wo) / pdf; for delta lobes, the lobe's throughput.
+    pub weight: Rgb,
+    /// Solid-angle density of `wo`; for delta lobes the discrete probability of the lobe.
+    pub pdf: f32,
+    pub delta: bool,
+}
+
+/// Closed set of materials; enum dispatch keeps the hot path free of virtual calls.
+#[derive(Clone, Debug)]
+pub enum BsdfKind {
+    Diffuse(Diffuse),
+}
+
+/// A material: a BSDF and whether it is used on both sides of the surface.
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub kind: BsdfKind,
+    pub two_sided: bool,
+}
+
+impl Material {
+    /// Two-sided materials mirror the configuration into the upper hemisphere.
+    #[inline]
+    fn orient(&self, wi: Vec3, wo: Vec3) -> (Vec3, Vec3) {
+        if self.two_sided && wi.z < 0.0 {
+            (Vec3::new(wi.x, wi.y, -wi.z), Vec3::new(wo.x, wo.y, -wo.z))
+        } else {
+            (wi, wo)
+        }
+    }
+
+    /// True if every lobe is a Dirac delta (light sampling is then useless).
+    pub fn is_delta(&self) -> bool {
+        match &self.kind {
+            BsdfKind::Diffuse(_) => false,
+        }
+    }
+
+    #[inline]
+    pub fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
+        let (wi, wo) = self.orient(wi, wo);
+        match &self.kind {
+            BsdfKind::Diffuse(b) => b.eval(wi, wo),
+        }
+    }
+
+    #[inline]
+    pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+        let (wi, wo) = self.orient(wi, wo);
+        match &self.kind {
+            BsdfKind::Diffuse(b) => b.pdf(wi, wo),
+        }
+    }
+
+    /// `u1` picks a lobe, `u2` the direction within it: separate numbers for separate decisions.
+    #[inline]
+    pub fn sample(&self, wi: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        let flip = self.two_sided && wi.z < 0.0;
+        let wi_up = if flip {
+            Vec3::new(wi.x, wi.y, -wi.z)
+        } else {
+            wi
+        };
+        let _ = u1;
+        let mut s = match &self.kind {
+            BsdfKind::Diffuse(b) => b.sample(wi_up, u2)?,
+        };
+        if flip {
+            s.wo.z = -s.wo.z;
+        }
+        Some(s)
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod testing {
+    //! Checks every BSDF must pass: sample/eval/pdf agreement and energy bounds.
+    use super::*;
+    use crate::rng::Rng;
+    use crate::sampling::warps::square_to_uniform_sphere;
+
+    /// For many incident directions and samples: pdf() of the sampled direction equals the
+    /// returned pdf, and weight == eval/pdf (non-delta lobes), to 1e-3 relative.
+    pub fn check_sample_consistency(m: &Material, n: usize) {
+        let mut rng = Rng::new(17, 3);
+        for _ in 0..n {
+            let wi = square_to_uniform_sphere(rng.next_2d());
+            let Some(s) = m.sample(wi, rng.next_f32(), rng.next_2d()) else {
+                continue;
+            };
+            assert!(
+                s.weight.is_finite() && s.pdf.is_finite() && s.pdf > 0.0,
+                "{s:?}"
+            );
+            if s.delta {
+                continue;
+            }
+            let pdf = m.pdf(wi, s.wo);
+            assert!(
+                (pdf - s.pdf).abs() <= 1e-3 * s.pdf,
+                "pdf {pdf} vs sampled {}",
+                s.pdf
+            );
+            let w = m.eval(wi, s.wo) / s.pdf;
+            assert!(
+                (w - s.weight).abs().max_element() <= 1e-3 * w.max_element().max(1e-3),
+                "{w} vs {}",
+                s.weight
+            );
+        }
+    }
+
+    /// Directional albedo by sampling: E[weight] for a fixed wi. Returns (mean, std error).
+    pub fn albedo(m: &Material, wi: Vec3, n: usize) -> (Rgb, Rgb) {
+        let mut rng = Rng::new(23, 5);
+        let (mut s, mut s2) = (glam::DVec3::ZERO, glam::DVec3::ZERO);
+        for _ in 0..n {
+            if let Some(x) = m.sample(wi, rng.next_f32(), rng.next_2d()) {
+                let w = x.weight.as_dvec3();
+                s += w;
+                s2 += w * w;
+            }
+        }
+        let mean = s / n as f64;
+        let var = (s2 / n as f64 - mean * mean).max(glam::DVec3::ZERO);
+        (mean.as_vec3(), (var / n as f64).as_vec3().map(f32::sqrt))
+    }
+}

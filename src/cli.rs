@@ -1,0 +1,238 @@
+//! Command-line interface.
+
+use crate::emitter::{EmitterSelection, LightSampling};
+use crate::film;
+use crate::integrator::Strategy;
+use crate::render::{render, RenderSettings};
+use crate::scene::desc::{Heuristic, StrategyKind};
+use crate::scene::{load_scene, Scene};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+#[derive(Parser, Debug)]
+#[command(name = "directlab", version, about = "Monte Carlo direct illumination and its convergence harness")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a Mitsuba 3, Mitsuba 0.6 or Nori XML scene to EXR (plus an sRGB PNG preview).
+    Render(RenderArgs),
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum StrategyArg {
+    Bsdf,
+    Light,
+    Mis,
+    MisOnesample,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum SelectionArg {
+    Uniform,
+    Power,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum LightSamplingArg {
+    Area,
+    SolidAngle,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum HeuristicArg {
+    Balance,
+    Power,
+}
+
+/// Estimator choices; anything not given keeps the scene's own integrator settings.
+#[derive(Args, Debug, Clone, Default)]
+pub struct StrategyArgs {
+    #[arg(long, value_enum)]
+    pub strategy: Option<StrategyArg>,
+    #[arg(long, value_enum)]
+    pub emitter_selection: Option<SelectionArg>,
+    #[arg(long, value_enum)]
+    pub light_sampling: Option<LightSamplingArg>,
+    #[arg(long, value_enum)]
+    pub heuristic: Option<HeuristicArg>,
+    #[arg(long)]
+    pub emitter_samples: Option<u32>,
+    #[arg(long)]
+    pub bsdf_samples: Option<u32>,
+}
+
+impl StrategyArgs {
+    pub fn apply(&self, mut s: Strategy) -> Strategy {
+        if let Some(k) = self.strategy {
+            s.kind = match k {
+                StrategyArg::Bsdf => StrategyKind::Bsdf,
+                StrategyArg::Light => StrategyKind::Light,
+                StrategyArg::Mis => StrategyKind::Mis,
+                StrategyArg::MisOnesample => StrategyKind::MisOneSample,
+            };
+        }
+        if let Some(e) = self.emitter_selection {
+            s.selection = match e {
+                SelectionArg::Uniform => EmitterSelection::Uniform,
+                SelectionArg::Power => EmitterSelection::Power,
+            };
+        }
+        if let Some(l) = self.light_sampling {
+            s.light_sampling = match l {
+                LightSamplingArg::Area => LightSampling::Area,
+                LightSamplingArg::SolidAngle => LightSampling::SolidAngle,
+            };
+        }
+        if let Some(h) = self.heuristic {
+            s.heuristic = match h {
+                HeuristicArg::Balance => Heuristic::Balance,
+                HeuristicArg::Power => Heuristic::Power,
+            };
+        }
+        if let Some(n) = self.emitter_samples {
+            s.emitter_samples = n.max(1);
+        }
+        if let Some(n) = self.bsdf_samples {
+            s.bsdf_samples = n.max(1);
+        }
+        s
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file (XML).
+    pub scene: PathBuf,
+    /// Samples per pixel (default: the scene's sampler).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Seed (default: the scene's sampler seed).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Output EXR (default: <scene name>.exr in the current directory); a PNG preview is
+    /// written beside it.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Also write the per-pixel variance of the estimate (sample variance / spp) as EXR.
+    #[arg(long)]
+    pub variance: Option<PathBuf>,
+    /// Set a scene parameter declared with <default>: -D name=value (repeatable).
+    #[arg(short = 'D', value_parser = parse_define)]
+    pub define: Vec<(String, String)>,
+    /// Write render statistics as JSON.
+    #[arg(long)]
+    pub stats: Option<PathBuf>,
+    #[command(flatten)]
+    pub strategy: StrategyArgs,
+}
+
+fn parse_define(s: &str) -> Result<(String, String), String> {
+    let (k, v) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected name=value, found '{s}'"))?;
+    if k.is_empty() {
+        return Err(format!("expected name=value, found '{s}'"));
+    }
+    Ok((k.to_string(), v.to_string()))
+}
+
+/// Loads and builds a scene, printing its warnings to stderr.
+pub fn open_scene(path: &Path, defines: &[(String, String)]) -> Result<Scene, String> {
+    let desc = load_scene(path, defines).map_err(|e| e.to_string())?;
+    let scene = Scene::build(desc).map_err(|e| e.to_string())?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(scene)
+}
+
+#[derive(serde::Serialize)]
+struct RenderStats {
+    scene: String,
+    strategy: String,
+    spp: u32,
+    seed: u64,
+    threads: usize,
+    width: u32,
+    height: u32,
+    seconds: f64,
+    samples_per_second: f64,
+    non_finite_samples: u64,
+    mean_rgb: [f64; 3],
+}
+
+fn cmd_render(a: &RenderArgs) -> Result<(), String> {
+    let scene = open_scene(&a.scene, &a.define)?;
+    let strategy = a.strategy.apply(Strategy::from_desc(&scene.desc.integrator));
+    let settings = RenderSettings {
+        spp: a.spp.unwrap_or(scene.desc.sampler.sample_count).max(1),
+        seed: a.seed.unwrap_or(scene.desc.sampler.seed),
+        threads: a.threads,
+        progress: std::io::stderr().is_terminal(),
+    };
+    let out = a.out.clone().unwrap_or_else(|| {
+        let stem = a.scene.file_stem().unwrap_or_default().to_string_lossy().to_string();
+        PathBuf::from(format!("{stem}.exr"))
+    });
+    let result = render(&scene, strategy, &settings);
+    film::write_exr(&out, &result.mean)?;
+    film::write_png(&out.with_extension("png"), &result.mean)?;
+    if let Some(v) = &a.variance {
+        film::write_exr(v, &result.variance)?;
+    }
+    let stats = RenderStats {
+        scene: a.scene.display().to_string(),
+        strategy: strategy.label(),
+        spp: settings.spp,
+        seed: settings.seed,
+        threads: settings.threads.unwrap_or_else(rayon::current_num_threads),
+        width: result.mean.width,
+        height: result.mean.height,
+        seconds: result.seconds,
+        samples_per_second: result.samples_per_second(),
+        non_finite_samples: result.non_finite_samples,
+        mean_rgb: result.mean.mean_rgb(),
+    };
+    if let Some(p) = &a.stats {
+        let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
+        film::write_atomic(p, |tmp| std::fs::write(tmp, json).map_err(|e| format!("{}: {e}", p.display())))?;
+    }
+    eprintln!(
+        "{}: {}x{} at {} spp with {} in {:.2} s ({:.2} M samples/s) -> {}",
+        a.scene.display(),
+        stats.width,
+        stats.height,
+        stats.spp,
+        stats.strategy,
+        stats.seconds,
+        stats.samples_per_second / 1e6,
+        out.display()
+    );
+    if result.non_finite_samples > 0 {
+        eprintln!("warning: {} non-finite samples were replaced by 0", result.non_finite_samples);
+    }
+    Ok(())
+}
+
+/// Runs the CLI; returns the process exit code.
+pub fn main() -> i32 {
+    let cli = Cli::parse();
+    let r = match &cli.command {
+        Command::Render(a) => cmd_render(a),
+    };
+    match r {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("error: {e}");
+            1
+        }
+    }
+}

@@ -1,0 +1,176 @@
+//! Images in f64 linear RGB, and their files: EXR (linear) and PNG (sRGB preview), always
+//! written to a temporary file first and renamed, so a failed write never replaces a good file.
+
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub data: Vec<[f64; 3]>,
+}
+
+impl Image {
+    pub fn new(width: u32, height: u32) -> Self {
+        Image {
+            width,
+            height,
+            data: vec![[0.0; 3]; width as usize * height as usize],
+        }
+    }
+
+    #[inline]
+    pub fn get(&self, x: u32, y: u32) -> [f64; 3] {
+        self.data[(y * self.width + x) as usize]
+    }
+
+    #[inline]
+    pub fn set(&mut self, x: u32, y: u32, v: [f64; 3]) {
+        let w = self.width;
+        self.data[(y * w + x) as usize] = v;
+    }
+
+    /// Mean over all pixels, per channel.
+    pub fn mean_rgb(&self) -> [f64; 3] {
+        let mut s = [0.0f64; 3];
+        for p in &self.data {
+            for c in 0..3 {
+                s[c] += p[c];
+            }
+        }
+        let n = self.data.len().max(1) as f64;
+        s.map(|v| v / n)
+    }
+}
+
+/// A sibling path for the temporary file, in the same directory so rename is atomic.
+fn temp_path(path: &Path) -> PathBuf {
+    let mut name = path
+        .file_name()
+        .map(|n| n.to_os_string())
+        .unwrap_or_default();
+    name.push(format!(".tmp{}", std::process::id()));
+    path.with_file_name(name)
+}
+
+/// Writes through `write` into a temporary file, then renames it over `path`.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), String> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("{}: cannot create directory: {e}", dir.display()))?;
+    }
+    let tmp = temp_path(path);
+    let result = write(&tmp).and_then(|_| {
+        std::fs::rename(&tmp, path)
+            .map_err(|e| format!("{}: cannot rename into place: {e}", path.display()))
+    });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+pub fn write_exr(path: &Path, img: &Image) -> Result<(), String> {
+    write_atomic(path, |tmp| {
+        exr::prelude::write_rgb_file(tmp, img.width as usize, img.height as usize, |x, y| {
+            let p = img.get(x as u32, y as u32);
+            (p[0] as f32, p[1] as f32, p[2] as f32)
+        })
+        .map_err(|e| format!("{}: cannot write EXR: {e}", path.display()))
+    })
+}
+
+pub fn read_exr(path: &Path) -> Result<Image, String> {
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |res, _| Image::new(res.width() as u32, res.height() as u32),
+        |img: &mut Image, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            img.set(
+                pos.x() as u32,
+                pos.y() as u32,
+                [r as f64, g as f64, b as f64],
+            )
+        },
+    )
+    .map_err(|e| format!("{}: cannot read EXR: {e}", path.display()))?;
+    Ok(image.layer_data.channel_data.pixels)
+}
+
+#[inline]
+pub fn linear_to_srgb(v: f64) -> f64 {
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// 8-bit sRGB bytes of an image, clamped to [0, 1] after `exposure` scaling.
+pub fn to_srgb8(img: &Image, exposure: f64) -> Vec<u8> {
+    img.data
+        .iter()
+        .flat_map(|p| {
+            p.map(|c| (linear_to_srgb((c * exposure).clamp(0.0, 1.0)) * 255.0 + 0.5) as u8)
+        })
+        .collect()
+}
+
+pub fn write_png_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), String> {
+    write_atomic(path, |tmp| {
+        image::save_buffer_with_format(
+            tmp,
+            rgb,
+            width,
+            height,
+            image::ColorType::Rgb8,
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| format!("{}: cannot write PNG: {e}", path.display()))
+    })
+}
+
+pub fn write_png(path: &Path, img: &Image) -> Result<(), String> {
+    write_png_rgb8(path, img.width, img.height, &to_srgb8(img, 1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trip_and_no_temp_left() {
+        let dir = std::env::temp_dir().join(format!("directlab-film-{}", std::process::id()));
+        let mut img = Image::new(3, 2);
+        img.set(2, 1, [0.25, 1.5, 100.0]);
+        let path = dir.join("a.exr");
+        write_exr(&path, &img).unwrap();
+        let back = read_exr(&path).unwrap();
+        assert_eq!(back.get(2, 1), [0.25, 1.5, 100.0]);
+        write_png(&dir.join("a.png"), &img).unwrap();
+        let names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names.len(), 2, "{names:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn failed_write_keeps_old_file() {
+        let dir = std::env::temp_dir().join(format!("directlab-film2-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("keep.txt");
+        std::fs::write(&path, "good").unwrap();
+        let r = write_atomic(&path, |tmp| {
+            std::fs::write(tmp, "half").unwrap();
+            Err("boom".into())
+        });
+        assert!(r.is_err());
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "good");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,48 @@
+//! Geometry: shapes in world space, their intersection, and the BVH over all of them.
+
+pub mod accel;
+pub mod shape;
+
+pub use accel::Accel;
+pub use shape::{Mesh, Shape, ShapeKind, Sphere};
+
+use glam::Vec3;
+
+/// A ray with an explicit parametric interval; `d` need not be unit length.
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    pub o: Vec3,
+    pub d: Vec3,
+    pub tmin: f32,
+    pub tmax: f32,
+}
+
+impl Ray {
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        Ray {
+            o,
+            d,
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        }
+    }
+}
+
+/// A surface point found by a ray or drawn by a light sampler.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint {
+    pub p: Vec3,
+    /// Geometric normal, oriented to agree with the shading normal.
+    pub ng: Vec3,
+    /// Shading normal (interpolated vertex normals, or `ng`).
+    pub ns: Vec3,
+    pub shape: u32,
+    /// Triangle index within the shape (0 for spheres).
+    pub prim: u32,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    pub t: f32,
+    pub sp: SurfacePoint,
+}

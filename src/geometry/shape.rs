@@ -1,0 +1,220 @@
+//! World-space shapes: triangle meshes and exact spheres.
+
+use super::SurfacePoint;
+use crate::math::{max_abs, PI};
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    pub normals: Option<Vec<Vec3>>,
+    pub indices: Vec<[u32; 3]>,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct Sphere {
+    pub center: Vec3,
+    pub radius: f32,
+    pub flip_normals: bool,
+}
+
+#[derive(Clone, Debug)]
+pub enum ShapeKind {
+    Mesh(Mesh),
+    Sphere(Sphere),
+}
+
+#[derive(Clone, Debug)]
+pub struct Shape {
+    pub kind: ShapeKind,
+    pub material: u32,
+    pub emitter: Option<u32>,
+}
+
+impl Mesh {
+    #[inline]
+    pub fn vertices(&self, tri: usize) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[tri];
+        [
+            self.positions[a as usize],
+            self.positions[b as usize],
+            self.positions[c as usize],
+        ]
+    }
+
+    pub fn triangle_area(&self, tri: usize) -> f32 {
+        let [a, b, c] = self.vertices(tri);
+        0.5 * (b - a).cross(c - a).length()
+    }
+
+    /// The surface point at barycentrics (b1, b2) of a triangle. The position is recomputed
+    /// from the vertices, which keeps its rounding error proportional to the vertices' size
+    /// rather than to the ray's length.
+    #[inline]
+    pub fn surface_point(&self, tri: usize, b: Vec2, shape: u32) -> SurfacePoint {
+        let [a, v1, v2] = self.vertices(tri);
+        let b0 = 1.0 - b.x - b.y;
+        let p = a * b0 + v1 * b.x + v2 * b.y;
+        let ng = (v1 - a).cross(v2 - a).normalize_or_zero();
+        let mut ns = ng;
+        let mut ngo = ng;
+        if let Some(normals) = &self.normals {
+            let [i0, i1, i2] = self.indices[tri];
+            let n =
+                normals[i0 as usize] * b0 + normals[i1 as usize] * b.x + normals[i2 as usize] * b.y;
+            // Degenerate (zero or opposing) vertex normals fall back to the face normal.
+            if let Some(n) = n.try_normalize() {
+                ns = n;
+                if ng.dot(ns) < 0.0 {
+                    ngo = -ng;
+                }
+            }
+        }
+        SurfacePoint {
+            p,
+            ng: ngo,
+            ns,
+            shape,
+            prim: tri as u32,
+        }
+    }
+
+    pub fn bounds_scale(&self) -> f32 {
+        self.positions
+            .iter()
+            .map(|p| max_abs(*p))
+            .fold(0.0, f32::max)
+    }
+}
+
+impl Sphere {
+    pub fn area(&self) -> f32 {
+        4.0 * PI * self.radius * self.radius
+    }
+
+    /// Surface point from a point near the surface: projected back onto the sphere, which
+    /// removes the error that grows with the distance the ray travelled.
+    #[inline]
+    pub fn surface_point(&self, near: Vec3, shape: u32) -> SurfacePoint {
+        let n = (near - self.center).normalize_or(Vec3::Z);
+        let p = self.center + n * self.radius;
+        let n = if self.flip_normals { -n } else { n };
+        SurfacePoint {
+            p,
+            ng: n,
+            ns: n,
+            shape,
+            prim: 0,
+        }
+    }
+}
+
+/// Möller-Trumbore; returns (t, b1, b2) for hits strictly inside (tmin, tmax).
+#[inline(always)]
+pub fn intersect_triangle(
+    o: Vec3,
+    d: Vec3,
+    tmin: f32,
+    tmax: f32,
+    v0: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+) -> Option<(f32, f32, f32)> {
+    let pvec = d.cross(e2);
+    let det = e1.dot(pvec);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let tvec = o - v0;
+    let u = tvec.dot(pvec) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let qvec = tvec.cross(e1);
+    let v = d.dot(qvec) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let t = e2.dot(qvec) * inv;
+    if t > tmin && t < tmax {
+        Some((t, u, v))
+    } else {
+        None
+    }
+}
+
+/// Nearest root of |o + t d - c| = r inside (tmin, tmax). The discriminant is computed from
+/// the ray's perpendicular distance to the centre (Ray Tracing Gems ch. 7), which stays
+/// accurate when the sphere is small and far away.
+#[inline(always)]
+pub fn intersect_sphere(o: Vec3, d: Vec3, tmin: f32, tmax: f32, c: Vec3, r: f32) -> Option<f32> {
+    let f = o - c;
+    let a = d.dot(d);
+    let b = f.dot(d);
+    let cc = f.dot(f) - r * r;
+    let l = f - (b / a) * d;
+    let disc = a * (r * r - l.dot(l));
+    if disc < 0.0 {
+        return None;
+    }
+    let q = -(b + disc.sqrt().copysign(b));
+    if q == 0.0 {
+        return None;
+    }
+    let (mut t0, mut t1) = (cc / q, q / a);
+    if t0 > t1 {
+        std::mem::swap(&mut t0, &mut t1);
+    }
+    if t0 > tmin && t0 < tmax {
+        Some(t0)
+    } else if t1 > tmin && t1 < tmax {
+        Some(t1)
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triangle_hit_and_barycentrics() {
+        let (v0, v1, v2) = (Vec3::ZERO, Vec3::X, Vec3::Y);
+        let o = Vec3::new(0.25, 0.5, 1.0);
+        let (t, u, v) = intersect_triangle(o, -Vec3::Z, 0.0, 10.0, v0, v1 - v0, v2 - v0).unwrap();
+        assert!((t - 1.0).abs() < 1e-6 && (u - 0.25).abs() < 1e-6 && (v - 0.5).abs() < 1e-6);
+        assert!(intersect_triangle(o, Vec3::Z, 0.0, 10.0, v0, v1, v2).is_none());
+        assert!(intersect_triangle(o, -Vec3::Z, 0.0, 0.5, v0, v1, v2).is_none());
+        let outside = Vec3::new(0.8, 0.8, 1.0);
+        assert!(intersect_triangle(outside, -Vec3::Z, 0.0, 10.0, v0, v1, v2).is_none());
+    }
+
+    #[test]
+    fn sphere_hits_front_then_back() {
+        let c = Vec3::new(0.0, 0.0, 5.0);
+        let t = intersect_sphere(Vec3::ZERO, Vec3::Z, 0.0, 100.0, c, 1.0).unwrap();
+        assert!((t - 4.0).abs() < 1e-5);
+        let t = intersect_sphere(c, Vec3::Z, 0.0, 100.0, c, 1.0).unwrap();
+        assert!((t - 1.0).abs() < 1e-5);
+        assert!(intersect_sphere(Vec3::ZERO, Vec3::X, 0.0, 100.0, c, 1.0).is_none());
+        // Tiny sphere far away: the robust discriminant still finds it.
+        let far = Vec3::new(0.0, 0.0, 1e4);
+        let t = intersect_sphere(Vec3::ZERO, Vec3::Z, 0.0, 1e6, far, 1e-2).unwrap();
+        assert!((t - (1e4 - 1e-2)).abs() < 1e-2);
+    }
+
+    #[test]
+    fn interpolated_normal_uses_all_three_vertices() {
+        let m = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            normals: Some(vec![Vec3::Z, Vec3::new(1.0, 0.0, 1.0).normalize(), Vec3::Z]),
+            indices: vec![[0, 1, 2]],
+        };
+        let a = m.surface_point(0, Vec2::new(0.0, 0.0), 0).ns;
+        let b = m.surface_point(0, Vec2::new(0.5, 0.0), 0).ns;
+        assert!((a - Vec3::Z).length() < 1e-6);
+        assert!(b.x > 0.1, "vertex 1's normal must contribute: {b}");
+    }
+}

@@ -1,0 +1,206 @@
+//! The direct-lighting estimator for one camera ray.
+//!
+//! All densities are in solid angle. The light technique's density of a direction is
+//! pmf(emitter) * pdf_emitter(direction); the BSDF technique's is the BSDF's pdf. Multi-sample
+//! MIS weights each technique with h(n_i p_i, n_j p_j) (Veach's heuristics); one-sample MIS
+//! picks a technique with probability c_i and weights by h(c_i p_i, c_j p_j) / c_i.
+
+use super::Strategy;
+use crate::bsdf::Material;
+use crate::emitter::{EmitterSelector, LightSample};
+use crate::geometry::{Ray, SurfacePoint};
+use crate::math::{offset_origin, Frame, Rgb};
+use crate::rng::Rng;
+use crate::scene::desc::{Heuristic, StrategyKind};
+use crate::scene::Scene;
+use glam::Vec3;
+
+pub struct Direct<'a> {
+    pub scene: &'a Scene,
+    pub strategy: Strategy,
+    selector: EmitterSelector,
+}
+
+#[inline]
+fn heuristic(h: Heuristic, a: f32, b: f32) -> f32 {
+    let (a, b) = match h {
+        Heuristic::Balance => (a, b),
+        Heuristic::Power => (a * a, b * b),
+    };
+    if a == 0.0 || b.is_infinite() {
+        0.0
+    } else {
+        a / (a + b)
+    }
+}
+
+/// Shading context at a camera-ray hit.
+struct Shading<'m> {
+    sp: SurfacePoint,
+    frame: Frame,
+    wi: Vec3,
+    mat: &'m Material,
+}
+
+impl<'a> Direct<'a> {
+    pub fn new(scene: &'a Scene, strategy: Strategy) -> Self {
+        Direct {
+            scene,
+            strategy,
+            selector: EmitterSelector::new(&scene.emitters, strategy.selection),
+        }
+    }
+
+    /// Radiance along a camera ray.
+    pub fn li(&self, ray: &Ray, rng: &mut Rng) -> Rgb {
+        let scene = self.scene;
+        let Some(hit) = scene.intersect(ray) else {
+            return Rgb::ZERO;
+        };
+        let sp = hit.sp;
+        let mut l = Rgb::ZERO;
+        if !self.strategy.hide_emitters {
+            if let Some((_, e)) = scene.emitter_at(&sp) {
+                l += e.le(&sp, -ray.d);
+            }
+        }
+        let frame = Frame::from_normal(sp.ns);
+        let sh = Shading {
+            sp,
+            frame,
+            wi: frame.to_local(-ray.d),
+            mat: scene.material(&sp),
+        };
+        let s = &self.strategy;
+        let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
+        // A delta BSDF gives light samples zero throughput: all its light arrives via BSDF
+        // samples, which then carry weight 1.
+        let delta_bsdf = sh.mat.is_delta();
+        match s.kind {
+            StrategyKind::Light => {
+                for _ in 0..s.emitter_samples {
+                    l += self.light_sample(&sh, rng, |_, _| 1.0) / ne;
+                }
+            }
+            StrategyKind::Bsdf => {
+                for _ in 0..s.bsdf_samples {
+                    l += self.bsdf_sample(&sh, rng, |_, _| 1.0) / nb;
+                }
+            }
+            StrategyKind::Mis => {
+                if !delta_bsdf {
+                    for _ in 0..s.emitter_samples {
+                        l += self.light_sample(&sh, rng, |pl, pb| {
+                            heuristic(s.heuristic, ne * pl, nb * pb)
+                        }) / ne;
+                    }
+                }
+                let ne_drawn = if delta_bsdf { 0.0 } else { ne };
+                for _ in 0..s.bsdf_samples {
+                    l += self.bsdf_sample(&sh, rng, |pb, pl| {
+                        heuristic(s.heuristic, nb * pb, ne_drawn * pl)
+                    }) / nb;
+                }
+            }
+            StrategyKind::MisOneSample => {
+                let c_light = if delta_bsdf { 0.0 } else { ne / (ne + nb) };
+                let c_bsdf = 1.0 - c_light;
+                if rng.next_f32() < c_light {
+                    l += self.light_sample(&sh, rng, |pl, pb| {
+                        heuristic(s.heuristic, c_light * pl, c_bsdf * pb) / c_light
+                    });
+                } else {
+                    l += self.bsdf_sample(&sh, rng, |pb, pl| {
+                        heuristic(s.heuristic, c_bsdf * pb, c_light * pl) / c_bsdf
+                    });
+                }
+            }
+        }
+        l
+    }
+
+    /// One light-technique sample. `weight(p_light, p_bsdf)` is its MIS weight divided by the
+    /// technique's selection probability; a delta light is asked with p_bsdf = 0, since no
+    /// other technique can produce it.
+    #[inline]
+    fn light_sample(&self, sh: &Shading, rng: &mut Rng, weight: impl Fn(f32, f32) -> f32) -> Rgb {
+        let scene = self.scene;
+        let Some((ei, pmf)) = self.selector.sample(rng.next_f32()) else {
+            return Rgb::ZERO;
+        };
+        let u_prim = rng.next_f32();
+        let u = rng.next_2d();
+        let Some(ls): Option<LightSample> = scene.emitters[ei].sample(
+            &scene.shapes,
+            sh.sp.p,
+            u_prim,
+            u,
+            self.strategy.light_sampling,
+        ) else {
+            return Rgb::ZERO;
+        };
+        let wo = sh.frame.to_local(ls.wi);
+        let f = sh.mat.eval(sh.wi, wo);
+        if f == Rgb::ZERO || ls.li == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        let to_ng = if ls.delta { None } else { Some(ls.ng) };
+        if !scene.visible(&sh.sp, ls.p, to_ng) {
+            return Rgb::ZERO;
+        }
+        let p_light = pmf * ls.pdf;
+        let p_bsdf = if ls.delta { 0.0 } else { sh.mat.pdf(sh.wi, wo) };
+        let w = weight(p_light, p_bsdf);
+        f * ls.li * (w / p_light)
+    }
+
+    /// One BSDF-technique sample: follow the sampled direction and collect emission there.
+    /// Delta lobes are asked for their weight with p_light = 0 (light sampling cannot hit them).
+    #[inline]
+    fn bsdf_sample(&self, sh: &Shading, rng: &mut Rng, weight: impl Fn(f32, f32) -> f32) -> Rgb {
+        let scene = self.scene;
+        let u1 = rng.next_f32();
+        let u2 = rng.next_2d();
+        let Some(bs) = sh.mat.sample(sh.wi, u1, u2) else {
+            return Rgb::ZERO;
+        };
+        let d = sh.frame.to_world(bs.wo);
+        let ray = Ray::new(offset_origin(sh.sp.p, sh.sp.ng, d), d);
+        let Some(hit) = scene.intersect(&ray) else {
+            return Rgb::ZERO;
+        };
+        let Some((ei, e)) = scene.emitter_at(&hit.sp) else {
+            return Rgb::ZERO;
+        };
+        let le = e.le(&hit.sp, -d);
+        if le == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        let p_light = if bs.delta {
+            0.0
+        } else {
+            self.selector.pmf(ei)
+                * e.pdf(
+                    &scene.shapes,
+                    sh.sp.p,
+                    &hit.sp,
+                    self.strategy.light_sampling,
+                )
+        };
+        let w = weight(bs.pdf, p_light);
+        bs.weight * le * w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn heuristics() {
+        assert_eq!(heuristic(Heuristic::Balance, 1.0, 3.0), 0.25);
+        assert_eq!(heuristic(Heuristic::Power, 1.0, 3.0), 0.1);
+        assert_eq!(heuristic(Heuristic::Balance, 0.0, 0.0), 0.0);
+        assert_eq!(heuristic(Heuristic::Balance, 2.0, 0.0), 1.0);
+    }
+}

@@ -1,0 +1,10 @@
+//! Direct-illumination estimators: light sampling, BSDF sampling and their MIS combinations.
+
+mod direct;
+mod strategy;
+
+pub use direct::Direct;
+pub use strategy::Strategy;
+
+#[cfg(test)]
+pub(crate) mod tests;

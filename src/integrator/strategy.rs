@@ -1,0 +1,111 @@
+//! The estimator settings a render uses, and their stable short labels.
+
+use crate::emitter::{EmitterSelection, LightSampling};
+use crate::scene::desc::{Heuristic, IntegratorDesc, StrategyKind};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Strategy {
+    pub kind: StrategyKind,
+    pub heuristic: Heuristic,
+    pub emitter_samples: u32,
+    pub bsdf_samples: u32,
+    pub selection: EmitterSelection,
+    pub light_sampling: LightSampling,
+    pub hide_emitters: bool,
+}
+
+impl Strategy {
+    /// The scene's own integrator settings, with the study's defaults for what XML cannot say
+    /// (uniform emitter choice, area sampling).
+    pub fn from_desc(d: &IntegratorDesc) -> Self {
+        Strategy {
+            kind: d.strategy,
+            heuristic: d.heuristic,
+            emitter_samples: d.emitter_samples.max(1),
+            bsdf_samples: d.bsdf_samples.max(1),
+            selection: EmitterSelection::Uniform,
+            light_sampling: LightSampling::Area,
+            hide_emitters: d.hide_emitters,
+        }
+    }
+
+    /// Stable label for file names, CSV rows and plot legends, e.g. `mis-power-e1b1-uni-area`.
+    pub fn label(&self) -> String {
+        let sel = match self.selection {
+            EmitterSelection::Uniform => "uni",
+            EmitterSelection::Power => "pow",
+        };
+        let ls = match self.light_sampling {
+            LightSampling::Area => "area",
+            LightSampling::SolidAngle => "sa",
+        };
+        let h = match self.heuristic {
+            Heuristic::Balance => "balance",
+            Heuristic::Power => "power",
+        };
+        match self.kind {
+            StrategyKind::Light => format!("light-e{}-{sel}-{ls}", self.emitter_samples),
+            StrategyKind::Bsdf => format!("bsdf-b{}", self.bsdf_samples),
+            StrategyKind::Mis => format!(
+                "mis-{h}-e{}b{}-{sel}-{ls}",
+                self.emitter_samples, self.bsdf_samples
+            ),
+            StrategyKind::MisOneSample => format!("mis1-{h}-{sel}-{ls}"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_are_distinct_per_setting() {
+        let base = Strategy {
+            kind: StrategyKind::Mis,
+            heuristic: Heuristic::Power,
+            emitter_samples: 1,
+            bsdf_samples: 1,
+            selection: EmitterSelection::Uniform,
+            light_sampling: LightSampling::Area,
+            hide_emitters: false,
+        };
+        assert_eq!(base.label(), "mis-power-e1b1-uni-area");
+        let variants = [
+            Strategy {
+                heuristic: Heuristic::Balance,
+                ..base
+            },
+            Strategy {
+                selection: EmitterSelection::Power,
+                ..base
+            },
+            Strategy {
+                light_sampling: LightSampling::SolidAngle,
+                ..base
+            },
+            Strategy {
+                emitter_samples: 4,
+                ..base
+            },
+            Strategy {
+                kind: StrategyKind::Light,
+                ..base
+            },
+            Strategy {
+                kind: StrategyKind::Bsdf,
+                ..base
+            },
+            Strategy {
+                kind: StrategyKind::MisOneSample,
+                ..base
+            },
+        ];
+        let mut labels: Vec<String> = variants.iter().map(Strategy::label).collect();
+        labels.push(base.label());
+        let n = labels.len();
+        labels.sort();
+        labels.dedup();
+        assert_eq!(labels.len(), n);
+    }
+}

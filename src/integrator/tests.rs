@@ -1,0 +1,146 @@
+//! End-to-end estimator tests on scenes with known answers. Each statistical assertion is a
+//! two-sided z-test of the image mean (pixels are independent, so its variance is the sum of
+//! the per-pixel variances over N^2) at alpha = 0.01, Sidak-corrected over the cases.
+
+use super::Strategy;
+use crate::emitter::{EmitterSelection, LightSampling};
+use crate::render::{render, RenderOutput, RenderSettings};
+use crate::scene::desc::{Heuristic, StrategyKind};
+use crate::scene::{fixtures, Scene};
+use statrs::distribution::{ContinuousCDF, Normal};
+
+pub(crate) fn all_strategies() -> Vec<Strategy> {
+    let mut v = Vec::new();
+    for selection in [EmitterSelection::Uniform, EmitterSelection::Power] {
+        for light_sampling in [LightSampling::Area, LightSampling::SolidAngle] {
+            let base = Strategy {
+                kind: StrategyKind::Light,
+                heuristic: Heuristic::Balance,
+                emitter_samples: 1,
+                bsdf_samples: 1,
+                selection,
+                light_sampling,
+                hide_emitters: false,
+            };
+            v.push(base);
+            v.push(Strategy {
+                kind: StrategyKind::Mis,
+                ..base
+            });
+            v.push(Strategy {
+                kind: StrategyKind::Mis,
+                heuristic: Heuristic::Power,
+                emitter_samples: 2,
+                ..base
+            });
+            v.push(Strategy {
+                kind: StrategyKind::MisOneSample,
+                ..base
+            });
+            v.push(Strategy {
+                kind: StrategyKind::MisOneSample,
+                heuristic: Heuristic::Power,
+                ..base
+            });
+        }
+    }
+    v.push(Strategy {
+        kind: StrategyKind::Bsdf,
+        ..v[0]
+    });
+    v.push(Strategy {
+        kind: StrategyKind::Bsdf,
+        bsdf_samples: 3,
+        ..v[0]
+    });
+    v
+}
+
+/// Two-sided critical |z| at level alpha, Sidak-corrected for `m` tests.
+pub(crate) fn z_critical(alpha: f64, m: usize) -> f64 {
+    let a = 1.0 - (1.0 - alpha).powf(1.0 / m as f64);
+    Normal::new(0.0, 1.0).unwrap().inverse_cdf(1.0 - a / 2.0)
+}
+
+/// z statistic of the image mean of channel 0 against `expected`. A zero-variance estimate
+/// (BSDF sampling in a furnace) must be exact up to f32 rounding: that case returns z = 0
+/// only if it is within 1e-6 relative, and infinity otherwise.
+pub(crate) fn image_z(out: &RenderOutput, expected: f64) -> (f64, f64) {
+    let n = out.mean.data.len() as f64;
+    let mean = out.mean.data.iter().map(|p| p[0]).sum::<f64>() / n;
+    let var = out.variance.data.iter().map(|p| p[0]).sum::<f64>() / (n * n);
+    if var == 0.0 {
+        let exact = (mean - expected).abs() <= 1e-6 * expected.abs();
+        return (if exact { 0.0 } else { f64::INFINITY }, mean);
+    }
+    ((mean - expected) / var.sqrt(), mean)
+}
+
+fn settings(spp: u32, seed: u64) -> RenderSettings {
+    RenderSettings {
+        spp,
+        seed,
+        threads: None,
+        progress: false,
+    }
+}
+
+#[test]
+fn furnace_renders_one_plus_albedo_for_every_strategy() {
+    let albedo = 0.6;
+    let strategies = all_strategies();
+    let zc = z_critical(0.01, strategies.len() * 2);
+    for split in [false, true] {
+        let scene = Scene::build(fixtures::furnace(albedo, split, 16)).unwrap();
+        for s in &strategies {
+            let out = render(&scene, *s, &settings(32, 1));
+            assert_eq!(out.non_finite_samples, 0);
+            let (z, mean) = image_z(&out, 1.0 + albedo as f64);
+            assert!(
+                z.abs() < zc,
+                "{} split={split}: mean {mean} vs {}, z = {z:.2} (critical {zc:.2})",
+                s.label(),
+                1.0 + albedo
+            );
+        }
+    }
+}
+
+#[test]
+fn furnace_catches_a_missing_emitter_pmf() {
+    // The study's bug: with six emitters, forgetting to divide by pmf = 1/6 scales the
+    // reflected term by 1/6. The test above must be able to see an error of that size.
+    let scene = Scene::build(fixtures::furnace(0.6, true, 16)).unwrap();
+    let out = render(&scene, all_strategies()[0], &settings(32, 1));
+    let (z, _) = image_z(&out, 1.0 + 0.6 / 6.0);
+    assert!(
+        z.abs() > 10.0,
+        "a biased reference value must be rejected, z = {z}"
+    );
+}
+
+#[test]
+fn same_seed_same_bytes_for_any_thread_count() {
+    let scene = Scene::build(fixtures::furnace(0.5, true, 24)).unwrap();
+    let s = Strategy::from_desc(&scene.desc.integrator);
+    let mut a = settings(8, 7);
+    a.threads = Some(1);
+    let mut b = a.clone();
+    b.threads = Some(2);
+    let (ra, rb) = (render(&scene, s, &a), render(&scene, s, &b));
+    let bytes = |o: &RenderOutput| {
+        o.mean
+            .data
+            .iter()
+            .flat_map(|p| p.map(f64::to_bits))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(bytes(&ra), bytes(&rb));
+    let mut c = a.clone();
+    c.seed = 8;
+    assert_ne!(
+        bytes(&ra),
+        bytes(&render(&scene, s, &c)),
+        "a different seed must change the image"
+    );
+}

@@ -1,0 +1,226 @@
+//! Uniform sampling of the solid angle a triangle subtends (Arvo 1995, in the form pbrt-v4
+//! uses), so a light sample's density is 1 / Omega instead of d^2 / (A cos).
+
+use crate::math::PI;
+use glam::{Vec2, Vec3};
+
+/// Below this solid angle the spherical-triangle formulas lose precision, above it the
+/// triangle nearly surrounds the point: pbrt-v4 samples by area in both cases.
+pub const MIN_SOLID_ANGLE: f32 = 3e-4;
+pub const MAX_SOLID_ANGLE: f32 = 6.22;
+
+/// The projected triangle: unit vertex directions, arc normals and corner angles.
+struct SphericalTriangle {
+    a: Vec3,
+    b: Vec3,
+    c: Vec3,
+    alpha: f32,
+    area: f32,
+}
+
+#[inline]
+fn angle_between(u: Vec3, v: Vec3) -> f32 {
+    // Numerically better than acos(dot) near 0 and pi.
+    if u.dot(v) < 0.0 {
+        PI - 2.0 * ((u + v).length() * 0.5).clamp(-1.0, 1.0).asin()
+    } else {
+        2.0 * ((v - u).length() * 0.5).clamp(-1.0, 1.0).asin()
+    }
+}
+
+impl SphericalTriangle {
+    #[inline]
+    fn new(p: Vec3, v: [Vec3; 3]) -> Option<Self> {
+        let a = (v[0] - p).try_normalize()?;
+        let b = (v[1] - p).try_normalize()?;
+        let c = (v[2] - p).try_normalize()?;
+        let n_ab = a.cross(b).try_normalize()?;
+        let n_bc = b.cross(c).try_normalize()?;
+        let n_ca = c.cross(a).try_normalize()?;
+        let alpha = angle_between(n_ab, -n_ca);
+        let beta = angle_between(n_bc, -n_ab);
+        let gamma = angle_between(n_ca, -n_bc);
+        let area = alpha + beta + gamma - PI;
+        if !(area > 0.0) {
+            return None;
+        }
+        Some(SphericalTriangle {
+            a,
+            b,
+            c,
+            alpha,
+            area,
+        })
+    }
+}
+
+/// Solid angle of the triangle seen from `p` (spherical excess), or 0 if degenerate.
+#[inline]
+pub fn spherical_triangle_area(p: Vec3, v: [Vec3; 3]) -> f32 {
+    SphericalTriangle::new(p, v).map_or(0.0, |t| t.area)
+}
+
+/// Whether the spherical-triangle sampler is used for a triangle of this solid angle.
+#[inline]
+pub fn use_solid_angle(area: f32) -> bool {
+    (MIN_SOLID_ANGLE..=MAX_SOLID_ANGLE).contains(&area)
+}
+
+/// A unit direction uniformly distributed in the triangle's solid angle, with its density
+/// 1 / Omega; None when the triangle is outside the usable range (caller samples by area).
+#[inline]
+pub fn sample_spherical_triangle(p: Vec3, v: [Vec3; 3], u: Vec2) -> Option<(Vec3, f32)> {
+    let t = SphericalTriangle::new(p, v)?;
+    if !use_solid_angle(t.area) {
+        return None;
+    }
+    let (a, b, c, alpha) = (t.a, t.b, t.c, t.alpha);
+    // Choose the sub-triangle area, then the point c' on arc ac that produces it.
+    // phi = (A' + pi) - alpha, with A' the sub-triangle's area.
+    let (sin_phi, cos_phi) = (PI + u.x * t.area - alpha).sin_cos();
+    let (sin_alpha, cos_alpha) = alpha.sin_cos();
+    let cos_c = a.dot(b);
+    let k1 = cos_phi + cos_alpha;
+    let k2 = sin_phi - sin_alpha * cos_c;
+    let denom = (k2 * sin_phi + k1 * cos_phi) * sin_alpha;
+    let cos_bp = if denom != 0.0 {
+        ((k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha) / denom).clamp(-1.0, 1.0)
+    } else {
+        1.0
+    };
+    let sin_bp = (1.0 - cos_bp * cos_bp).max(0.0).sqrt();
+    let c_perp = (c - a * c.dot(a)).try_normalize()?;
+    let cp = a * cos_bp + c_perp * sin_bp;
+    // Then a point uniformly in solid angle on the arc from b to c'.
+    let cos_theta = 1.0 - u.y * (1.0 - cp.dot(b));
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let cp_perp = (cp - b * cp.dot(b)).try_normalize().unwrap_or(Vec3::ZERO);
+    let w = (b * cos_theta + cp_perp * sin_theta).try_normalize()?;
+    Some((w, 1.0 / t.area))
+}
+
+/// Barycentrics (b1, b2) where the ray p + t w meets the triangle's plane, clamped into the
+/// triangle (a direction from the sampler lies inside up to rounding).
+#[inline]
+pub fn ray_plane_barycentrics(p: Vec3, w: Vec3, v: [Vec3; 3]) -> Option<Vec2> {
+    let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
+    let n = e1.cross(e2);
+    let denom = n.dot(w);
+    if denom == 0.0 {
+        return None;
+    }
+    let t = n.dot(v[0] - p) / denom;
+    if !(t > 0.0) {
+        return None;
+    }
+    let x = p + w * t - v[0];
+    let inv = 1.0 / n.length_squared();
+    let b1 = x.cross(e2).dot(n) * inv;
+    let b2 = e1.cross(x).dot(n) * inv;
+    let b1 = b1.clamp(0.0, 1.0);
+    let b2 = b2.clamp(0.0, 1.0 - b1);
+    Some(Vec2::new(b1, b2))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+
+    /// Van Oosterom-Strackee, an independent formula for the same solid angle.
+    fn solid_angle_vos(p: Vec3, v: [Vec3; 3]) -> f64 {
+        let [a, b, c] = v.map(|x| (x - p).as_dvec3().normalize());
+        let num = a.dot(b.cross(c)).abs();
+        let den = 1.0 + a.dot(b) + a.dot(c) + b.dot(c);
+        2.0 * num.atan2(den)
+    }
+
+    fn triangles() -> Vec<(Vec3, [Vec3; 3])> {
+        vec![
+            (
+                Vec3::ZERO,
+                [
+                    Vec3::new(-1.0, -1.0, 2.0),
+                    Vec3::new(1.0, -1.0, 2.0),
+                    Vec3::new(0.0, 1.0, 2.0),
+                ],
+            ),
+            (
+                Vec3::new(0.3, 0.2, 0.0),
+                [
+                    Vec3::new(0.0, 0.0, 0.5),
+                    Vec3::new(3.0, 0.0, 0.4),
+                    Vec3::new(0.0, 2.0, 0.1),
+                ],
+            ),
+            (
+                Vec3::new(5.0, 1.0, -2.0),
+                [
+                    Vec3::new(0.0, 0.0, 0.0),
+                    Vec3::new(1.0, 0.0, 0.0),
+                    Vec3::new(0.0, 1.0, 0.3),
+                ],
+            ),
+        ]
+    }
+
+    #[test]
+    fn area_matches_van_oosterom_strackee() {
+        for (p, v) in triangles() {
+            let a = spherical_triangle_area(p, v) as f64;
+            let b = solid_angle_vos(p, v);
+            assert!((a - b).abs() < 1e-4 * b.max(1e-3), "{a} vs {b}");
+        }
+    }
+
+    /// pbrt-v4's check: the mean of 1/pdf over samples is the solid angle, and every sample
+    /// direction actually hits the triangle. 100k samples per triangle; 1/pdf is constant, so
+    /// the tolerance only covers rounding.
+    #[test]
+    fn samples_hit_the_triangle_and_invert_to_its_solid_angle() {
+        let mut rng = Rng::new(2, 9);
+        for (p, v) in triangles() {
+            let omega = solid_angle_vos(p, v);
+            let mut s = 0.0f64;
+            let n = 100_000;
+            for _ in 0..n {
+                let (w, pdf) = sample_spherical_triangle(p, v, rng.next_2d()).unwrap();
+                s += 1.0 / pdf as f64;
+                let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
+                let hit = crate::geometry::shape::intersect_triangle(
+                    p,
+                    w,
+                    0.0,
+                    f32::INFINITY,
+                    v[0],
+                    e1,
+                    e2,
+                );
+                let b = ray_plane_barycentrics(p, w, v).unwrap();
+                assert!(
+                    hit.is_some() || b.x.min(b.y).min(1.0 - b.x - b.y) < 1e-4,
+                    "sample missed the triangle"
+                );
+            }
+            assert!((s / n as f64 - omega).abs() < 1e-3 * omega);
+        }
+    }
+
+    #[test]
+    fn tiny_and_huge_triangles_fall_back() {
+        let v = [
+            Vec3::new(0.0, 0.0, 1e3),
+            Vec3::new(1e-2, 0.0, 1e3),
+            Vec3::new(0.0, 1e-2, 1e3),
+        ];
+        assert!(sample_spherical_triangle(Vec3::ZERO, v, Vec2::splat(0.5)).is_none());
+        assert!(!use_solid_angle(spherical_triangle_area(Vec3::ZERO, v)));
+        let big = [
+            Vec3::new(-1e3, -1e3, 1e-3),
+            Vec3::new(1e3, -1e3, 1e-3),
+            Vec3::new(0.0, 1e3, 1e-3),
+        ];
+        assert!(spherical_triangle_area(Vec3::ZERO, big) > 6.22);
+        assert!(sample_spherical_triangle(Vec3::ZERO, big, Vec2::splat(0.5)).is_none());
+    }
+}

@@ -1,0 +1,202 @@
+//! Warps from the unit square to the study's domains, each with the density it produces.
+//! Densities are with respect to area on the target domain (solid angle for directions).
+
+use crate::math::{INV_PI, PI};
+use glam::{Vec2, Vec3};
+
+#[inline]
+pub fn square_to_uniform_disk(u: Vec2) -> Vec2 {
+    let r = u.x.sqrt();
+    let (s, c) = (2.0 * PI * u.y).sin_cos();
+    Vec2::new(r * c, r * s)
+}
+
+#[inline]
+pub fn square_to_uniform_disk_pdf(p: Vec2) -> f32 {
+    if p.length_squared() <= 1.0 {
+        INV_PI
+    } else {
+        0.0
+    }
+}
+
+/// Shirley-Chiu concentric map: less distortion than the polar map.
+#[inline]
+pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
+    let o = 2.0 * u - Vec2::ONE;
+    if o.x == 0.0 && o.y == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, PI / 4.0 * (o.y / o.x))
+    } else {
+        (o.y, PI / 2.0 - PI / 4.0 * (o.x / o.y))
+    };
+    let (s, c) = theta.sin_cos();
+    Vec2::new(r * c, r * s)
+}
+
+/// 1D tent on [-1, 1] by inverting its CDF.
+#[inline]
+fn tent_1d(u: f32) -> f32 {
+    let x = 2.0 * u;
+    if x < 1.0 {
+        x.sqrt() - 1.0
+    } else {
+        1.0 - (2.0 - x).sqrt()
+    }
+}
+
+/// Separable tent on [-1, 1]^2.
+#[inline]
+pub fn square_to_tent(u: Vec2) -> Vec2 {
+    Vec2::new(tent_1d(u.x), tent_1d(u.y))
+}
+
+#[inline]
+pub fn square_to_tent_pdf(p: Vec2) -> f32 {
+    (1.0 - p.x.abs()).max(0.0) * (1.0 - p.y.abs()).max(0.0)
+}
+
+/// Uniform barycentrics (b1, b2) on a triangle by the square-root map.
+#[inline]
+pub fn square_to_uniform_triangle(u: Vec2) -> Vec2 {
+    let s = u.x.sqrt();
+    Vec2::new(1.0 - s, u.y * s)
+}
+
+/// Density on the reference triangle (0,0),(1,0),(0,1), whose area is 1/2.
+#[inline]
+pub fn square_to_uniform_triangle_pdf(b: Vec2) -> f32 {
+    if b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 {
+        2.0
+    } else {
+        0.0
+    }
+}
+
+#[inline]
+pub fn square_to_uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (s, c) = (2.0 * PI * u.y).sin_cos();
+    Vec3::new(r * c, r * s, z)
+}
+
+#[inline]
+pub fn square_to_uniform_sphere_pdf(_v: Vec3) -> f32 {
+    0.25 * INV_PI
+}
+
+#[inline]
+pub fn square_to_uniform_hemisphere(u: Vec2) -> Vec3 {
+    let z = u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (s, c) = (2.0 * PI * u.y).sin_cos();
+    Vec3::new(r * c, r * s, z)
+}
+
+#[inline]
+pub fn square_to_uniform_hemisphere_pdf(v: Vec3) -> f32 {
+    if v.z > 0.0 {
+        0.5 * INV_PI
+    } else {
+        0.0
+    }
+}
+
+#[inline]
+pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = square_to_concentric_disk(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    Vec3::new(d.x, d.y, z)
+}
+
+#[inline]
+pub fn square_to_cosine_hemisphere_pdf(v: Vec3) -> f32 {
+    if v.z > 0.0 {
+        v.z * INV_PI
+    } else {
+        0.0
+    }
+}
+
+/// Uniform direction in the cone around +z with the given cos of its half-angle.
+#[inline]
+pub fn square_to_uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
+    let z = 1.0 - u.x * (1.0 - cos_max);
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (s, c) = (2.0 * PI * u.y).sin_cos();
+    Vec3::new(r * c, r * s, z)
+}
+
+#[inline]
+pub fn square_to_uniform_cone_pdf(v: Vec3, cos_max: f32) -> f32 {
+    if v.z >= cos_max {
+        1.0 / (2.0 * PI * (1.0 - cos_max))
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+
+    /// Monte Carlo estimate of the integral of pdf over [-1,1]^2 (or the sphere), a check that
+    /// the density is normalised. 400k samples: standard error well below the 1% tolerance.
+    fn integral_2d(pdf: impl Fn(Vec2) -> f32) -> f64 {
+        let mut rng = Rng::new(3, 0);
+        let n = 400_000;
+        let mut s = 0.0f64;
+        for _ in 0..n {
+            let p = rng.next_2d() * 2.0 - Vec2::ONE;
+            s += pdf(p) as f64 * 4.0;
+        }
+        s / n as f64
+    }
+
+    #[test]
+    fn planar_pdfs_integrate_to_one() {
+        assert!((integral_2d(square_to_uniform_disk_pdf) - 1.0).abs() < 0.01);
+        assert!((integral_2d(square_to_tent_pdf) - 1.0).abs() < 0.01);
+        assert!((integral_2d(square_to_uniform_triangle_pdf) - 1.0).abs() < 0.01);
+    }
+
+    #[test]
+    fn samples_land_in_support() {
+        let mut rng = Rng::new(5, 1);
+        for _ in 0..10_000 {
+            let u = rng.next_2d();
+            assert!(square_to_uniform_disk(u).length() <= 1.0 + 1e-6);
+            assert!(square_to_concentric_disk(u).length() <= 1.0 + 1e-6);
+            let b = square_to_uniform_triangle(u);
+            assert!(square_to_uniform_triangle_pdf(b) > 0.0 || b.x + b.y <= 1.0 + 1e-6);
+            assert!((square_to_uniform_sphere(u).length() - 1.0).abs() < 1e-5);
+            assert!(square_to_uniform_hemisphere(u).z >= 0.0);
+            let c = square_to_cosine_hemisphere(u);
+            assert!(c.z >= 0.0 && (c.length() - 1.0).abs() < 1e-5);
+            assert!(square_to_uniform_cone(u, 0.9).z >= 0.9 - 1e-6);
+            let t = square_to_tent(u);
+            assert!(t.x.abs() <= 1.0 && t.y.abs() <= 1.0);
+        }
+    }
+
+    #[test]
+    fn spherical_pdfs_integrate_to_one() {
+        let mut rng = Rng::new(9, 2);
+        let n = 400_000;
+        let (mut h, mut c, mut k) = (0.0f64, 0.0f64, 0.0f64);
+        for _ in 0..n {
+            let v = square_to_uniform_sphere(rng.next_2d());
+            let inv = 4.0 * std::f64::consts::PI;
+            h += square_to_uniform_hemisphere_pdf(v) as f64 * inv;
+            c += square_to_cosine_hemisphere_pdf(v) as f64 * inv;
+            k += square_to_uniform_cone_pdf(v, 0.5) as f64 * inv;
+        }
+        for s in [h, c, k] {
+            assert!((s / n as f64 - 1.0).abs() < 0.02, "{}", s / n as f64);
+        }
+    }
+}

@@ -1,0 +1,241 @@
+//! From a `SceneDesc` to the renderer's runtime scene: materials, emitters, sampling tables
+//! and the BVH. Checks what only makes sense once geometry is known (degenerate emitters).
+
+use super::desc::{BsdfDesc, SceneDesc, ShapeGeometry};
+use crate::bsdf::{BsdfKind, Diffuse, Material};
+use crate::camera::Camera;
+use crate::emitter::{AreaLight, Emitter, PointLight};
+use crate::geometry::{Accel, Hit, Mesh, Ray, Shape, ShapeKind, Sphere, SurfacePoint};
+use crate::math::{offset_origin, Rgb};
+use crate::sampling::AliasTable;
+use glam::Vec3;
+use std::fmt;
+
+/// A scene the renderer cannot use, with the element it came from.
+#[derive(Debug, Clone)]
+pub struct BuildError {
+    pub origin: String,
+    pub message: String,
+}
+
+impl fmt::Display for BuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.origin, self.message)
+    }
+}
+
+impl std::error::Error for BuildError {}
+
+pub struct Scene {
+    pub desc: SceneDesc,
+    pub shapes: Vec<Shape>,
+    pub materials: Vec<Material>,
+    pub emitters: Vec<Emitter>,
+    pub accel: Accel,
+    pub camera: Camera,
+    pub warnings: Vec<String>,
+}
+
+fn err(origin: &str, message: impl Into<String>) -> BuildError {
+    BuildError {
+        origin: origin.to_string(),
+        message: message.into(),
+    }
+}
+
+fn check_rgb(origin: &str, what: &str, c: Rgb) -> Result<(), BuildError> {
+    if !c.is_finite() || c.min_element() < 0.0 {
+        return Err(err(
+            origin,
+            format!("{what} must be finite and non-negative, found {c}"),
+        ));
+    }
+    Ok(())
+}
+
+fn material(origin: &str, desc: &BsdfDesc, two_sided: bool) -> Result<Material, BuildError> {
+    let kind = match desc {
+        BsdfDesc::TwoSided(inner) => {
+            if matches!(**inner, BsdfDesc::TwoSided(_)) {
+                return Err(err(origin, "twosided cannot nest another twosided"));
+            }
+            return material(origin, inner, true);
+        }
+        BsdfDesc::Diffuse { reflectance } => {
+            check_rgb(origin, "diffuse reflectance", *reflectance)?;
+            BsdfKind::Diffuse(Diffuse {
+                reflectance: *reflectance,
+            })
+        }
+        other => {
+            let name = format!("{other:?}");
+            let name = name.split([' ', '{', '(']).next().unwrap_or("");
+            return Err(err(
+                origin,
+                format!("material '{name}' is not supported yet"),
+            ));
+        }
+    };
+    Ok(Material { kind, two_sided })
+}
+
+impl Scene {
+    pub fn build(desc: SceneDesc) -> Result<Scene, BuildError> {
+        let mut shapes = Vec::new();
+        let mut materials = Vec::new();
+        let mut emitters = Vec::new();
+        let mut warnings = desc.warnings.clone();
+        for sd in &desc.shapes {
+            let o = sd.origin.as_str();
+            let shape_index = shapes.len() as u32;
+            materials.push(material(o, &sd.bsdf, false)?);
+            let kind = match &sd.geometry {
+                ShapeGeometry::Mesh {
+                    positions,
+                    normals,
+                    indices,
+                } => {
+                    if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+                        return Err(err(o, format!("mesh has a non-finite vertex {p}")));
+                    }
+                    if let Some(t) = indices
+                        .iter()
+                        .find(|t| t.iter().any(|&i| i as usize >= positions.len()))
+                    {
+                        return Err(err(
+                            o,
+                            format!(
+                                "triangle {t:?} indexes past the {} vertices",
+                                positions.len()
+                            ),
+                        ));
+                    }
+                    ShapeKind::Mesh(Mesh {
+                        positions: positions.clone(),
+                        normals: normals.clone(),
+                        indices: indices.clone(),
+                    })
+                }
+                ShapeGeometry::Sphere {
+                    center,
+                    radius,
+                    flip_normals,
+                } => {
+                    if !center.is_finite() || !radius.is_finite() || *radius <= 0.0 {
+                        return Err(err(o, format!("sphere needs a finite centre and positive radius, found {center} / {radius}")));
+                    }
+                    ShapeKind::Sphere(Sphere {
+                        center: *center,
+                        radius: *radius,
+                        flip_normals: *flip_normals,
+                    })
+                }
+            };
+            let mut emitter = None;
+            if let Some(e) = &sd.emitter {
+                check_rgb(o, "emitter radiance", e.radiance)?;
+                let (area, triangles) = match &kind {
+                    ShapeKind::Mesh(m) => {
+                        let areas: Vec<f64> = (0..m.indices.len())
+                            .map(|t| m.triangle_area(t) as f64)
+                            .collect();
+                        let degenerate = areas.iter().filter(|a| **a == 0.0).count();
+                        let table = AliasTable::new(&areas).ok_or_else(|| {
+                            err(
+                                o,
+                                "emitter mesh has zero total area (every triangle is degenerate)",
+                            )
+                        })?;
+                        if degenerate > 0 {
+                            warnings.push(format!(
+                                "{o}: {degenerate} zero-area triangle(s) in an emitter mesh are never sampled (they emit nothing)"
+                            ));
+                        }
+                        (table.total() as f32, Some(table))
+                    }
+                    ShapeKind::Sphere(s) => (s.area(), None),
+                };
+                if e.radiance == Rgb::ZERO {
+                    warnings.push(format!("{o}: emitter has zero radiance"));
+                }
+                emitter = Some(emitters.len() as u32);
+                emitters.push(Emitter::Area(AreaLight {
+                    shape: shape_index,
+                    radiance: e.radiance,
+                    area,
+                    triangles,
+                }));
+            }
+            shapes.push(Shape {
+                kind,
+                material: shape_index,
+                emitter,
+            });
+        }
+        for pl in &desc.point_lights {
+            if !pl.position.is_finite() {
+                return Err(err(
+                    &pl.origin,
+                    format!("point light position must be finite, found {}", pl.position),
+                ));
+            }
+            check_rgb(&pl.origin, "point light intensity", pl.intensity)?;
+            emitters.push(Emitter::Point(PointLight {
+                position: pl.position,
+                intensity: pl.intensity,
+            }));
+        }
+        if emitters.is_empty() {
+            return Err(err(
+                &desc.source.display().to_string(),
+                "scene has no emitters; directlab renders direct illumination only",
+            ));
+        }
+        let accel = Accel::build(&shapes);
+        let camera = Camera::new(&desc.camera, &desc.film);
+        Ok(Scene {
+            shapes,
+            materials,
+            emitters,
+            accel,
+            camera,
+            warnings,
+            desc,
+        })
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.accel.intersect(ray, &self.shapes)
+    }
+
+    /// Mutual visibility of a surface point and a point on a light. Both ends are moved off
+    /// their surfaces and the shadow ray stops just short of the light, so neither the
+    /// receiver nor the light itself counts as a blocker.
+    #[inline]
+    pub fn visible(&self, from: &SurfacePoint, to_p: Vec3, to_ng: Option<Vec3>) -> bool {
+        let o = offset_origin(from.p, from.ng, to_p - from.p);
+        let target = match to_ng {
+            Some(n) => offset_origin(to_p, n, o - to_p),
+            None => to_p,
+        };
+        let ray = Ray {
+            o,
+            d: target - o,
+            tmin: 0.0,
+            tmax: 1.0 - 1e-4,
+        };
+        !self.accel.occluded(&ray)
+    }
+
+    #[inline]
+    pub fn material(&self, sp: &SurfacePoint) -> &Material {
+        &self.materials[self.shapes[sp.shape as usize].material as usize]
+    }
+
+    #[inline]
+    pub fn emitter_at(&self, sp: &SurfacePoint) -> Option<(usize, &Emitter)> {
+        let e = self.shapes[sp.shape as usize].emitter? as usize;
+        Some((e, &self.emitters[e]))
+    }
+}

@@ -1,0 +1,199 @@
+//! Scenes built in code for tests and benchmarks, where a closed form is known.
+
+use super::desc::*;
+use crate::math::look_at;
+use glam::{Mat4, Vec3};
+use std::path::PathBuf;
+
+fn base(camera: Mat4, fov: f32, width: u32, height: u32, shapes: Vec<ShapeDesc>) -> SceneDesc {
+    SceneDesc {
+        source: PathBuf::from("<fixture>"),
+        camera: CameraDesc {
+            to_world: camera,
+            fov_degrees: fov,
+            fov_axis: FovAxis::X,
+            near_clip: 1e-4,
+            far_clip: 1e6,
+        },
+        film: FilmDesc {
+            width,
+            height,
+            filter: FilterDesc::Box,
+        },
+        sampler: SamplerDesc {
+            sample_count: 16,
+            seed: 0,
+        },
+        integrator: IntegratorDesc {
+            strategy: StrategyKind::Light,
+            heuristic: Heuristic::Balance,
+            emitter_samples: 1,
+            bsdf_samples: 1,
+            hide_emitters: false,
+        },
+        shapes,
+        point_lights: vec![],
+        warnings: vec![],
+    }
+}
+
+pub fn mesh(
+    positions: Vec<Vec3>,
+    indices: Vec<[u32; 3]>,
+    bsdf: BsdfDesc,
+    radiance: Option<Rgb>,
+) -> ShapeDesc {
+    ShapeDesc {
+        geometry: ShapeGeometry::Mesh {
+            positions,
+            normals: None,
+            indices,
+        },
+        bsdf,
+        emitter: radiance.map(|radiance| AreaEmitterDesc { radiance }),
+        origin: "<fixture>".into(),
+    }
+}
+
+pub fn diffuse(a: f32) -> BsdfDesc {
+    BsdfDesc::Diffuse {
+        reflectance: Rgb::splat(a),
+    }
+}
+
+/// A one-sided triangle light (emitting towards the side its counter-clockwise winding
+/// faces) over a large diffuse floor z = 0, and a one-pixel camera with a tiny field of view
+/// looking straight down at the receiver point `x` on the floor, from `height` above it.
+pub fn triangle_over_floor(
+    tri: [Vec3; 3],
+    radiance: f32,
+    albedo: f32,
+    x: Vec3,
+    height: f32,
+) -> SceneDesc {
+    let s = 1e3;
+    let floor = mesh(
+        vec![
+            Vec3::new(-s, -s, 0.0),
+            Vec3::new(s, -s, 0.0),
+            Vec3::new(s, s, 0.0),
+            Vec3::new(-s, s, 0.0),
+        ],
+        vec![[0, 1, 2], [0, 2, 3]],
+        diffuse(albedo),
+        None,
+    );
+    let light = mesh(
+        tri.to_vec(),
+        vec![[0, 1, 2]],
+        diffuse(0.0),
+        Some(Rgb::splat(radiance)),
+    );
+    let eye = x + Vec3::Z * height;
+    base(look_at(eye, x, Vec3::Y), 1e-3, 1, 1, vec![floor, light])
+}
+
+/// A closed cube [-1,1]^3 whose inward-facing faces are diffuse (albedo `a`) and emit L = 1.
+/// With direct lighting only, every pixel is exactly 1 + a. `split` makes each face its own
+/// emitter (exercising emitter choice), otherwise the cube is one emitter mesh.
+pub fn furnace(a: f32, split: bool, width: u32) -> SceneDesc {
+    let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+    let mut faces: [[Vec3; 4]; 6] = [
+        [
+            v(-1., -1., -1.),
+            v(-1., 1., -1.),
+            v(1., 1., -1.),
+            v(1., -1., -1.),
+        ],
+        [
+            v(-1., -1., 1.),
+            v(1., -1., 1.),
+            v(1., 1., 1.),
+            v(-1., 1., 1.),
+        ],
+        [
+            v(-1., -1., -1.),
+            v(1., -1., -1.),
+            v(1., -1., 1.),
+            v(-1., -1., 1.),
+        ],
+        [
+            v(-1., 1., -1.),
+            v(-1., 1., 1.),
+            v(1., 1., 1.),
+            v(1., 1., -1.),
+        ],
+        [
+            v(-1., -1., -1.),
+            v(-1., -1., 1.),
+            v(-1., 1., 1.),
+            v(-1., 1., -1.),
+        ],
+        [
+            v(1., -1., -1.),
+            v(1., 1., -1.),
+            v(1., 1., 1.),
+            v(1., -1., 1.),
+        ],
+    ];
+    // Wind every face so its normal (right-hand rule) points into the cube.
+    for f in &mut faces {
+        let n = (f[1] - f[0]).cross(f[2] - f[0]);
+        if n.dot(f[0] + f[2]) > 0.0 {
+            f.reverse();
+        }
+    }
+    let quad = |f: &[Vec3; 4]| (f.to_vec(), vec![[0u32, 1, 2], [0, 2, 3]]);
+    let shapes = if split {
+        faces
+            .iter()
+            .map(|f| {
+                let (p, i) = quad(f);
+                mesh(p, i, diffuse(a), Some(Rgb::ONE))
+            })
+            .collect()
+    } else {
+        let mut p = Vec::new();
+        let mut idx = Vec::new();
+        for f in &faces {
+            let b = p.len() as u32;
+            p.extend_from_slice(f);
+            idx.push([b, b + 1, b + 2]);
+            idx.push([b, b + 2, b + 3]);
+        }
+        vec![mesh(p, idx, diffuse(a), Some(Rgb::ONE))]
+    };
+    let cam = look_at(
+        Vec3::new(0.2, -0.3, -0.5),
+        Vec3::new(0.0, 0.3, 1.0),
+        Vec3::Y,
+    );
+    base(cam, 100.0, width, width, shapes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    #[test]
+    fn furnace_normals_point_inwards() {
+        let d = furnace(0.5, false, 4);
+        let ShapeGeometry::Mesh {
+            positions, indices, ..
+        } = &d.shapes[0].geometry
+        else {
+            unreachable!()
+        };
+        for t in indices {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            let n = (b - a).cross(c - a);
+            let centre = (a + b + c) / 3.0;
+            assert!(
+                n.dot(-centre) > 0.0,
+                "face normal must point to the cube's centre"
+            );
+        }
+        assert!(Scene::build(d).is_ok());
+    }
+}
