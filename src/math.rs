@@ -44,21 +44,24 @@ impl Frame {
     }
 }
 
-/// Largest absolute component; the scale of a point's floating-point rounding error.
+/// Largest absolute component.
 #[inline]
 pub fn max_abs(p: Vec3) -> f32 {
     p.abs().max_element()
 }
 
-/// Relative offset that moves a spawned ray's origin clear of its own surface. Hit points are
-/// recomputed from barycentrics (error about 8 ulp of |p|) and the ray-triangle test adds a
-/// few more; 2^-17 of |p| leaves a safety factor of about 64 at any scene scale.
-pub const SPAWN_REL_OFFSET: f32 = 1.0 / 131_072.0;
+/// Offset, relative to a point's error scale, that moves a spawned ray's origin clear of its
+/// own surface. A point recomputed from barycentrics is off by at most gamma(7) ~ 4.2e-7 of
+/// its vertices' magnitude per component (pbrt-v4's bound), so at most sqrt(3) times that
+/// along the normal; 2^-19 (1.9e-6) covers it 2.6 times over. The triangle test itself
+/// rejects hits within its own error bound on t, so the offset need not cover that too.
+pub const SPAWN_REL_OFFSET: f32 = 1.0 / 524_288.0;
 
-/// Origin for a ray leaving `p` (geometric normal `ng`) towards direction `d`.
+/// Origin for a ray leaving `p` (geometric normal `ng`, position error scale `err_scale`)
+/// towards direction `d`.
 #[inline]
-pub fn offset_origin(p: Vec3, ng: Vec3, d: Vec3) -> Vec3 {
-    let delta = (max_abs(p) * SPAWN_REL_OFFSET).max(f32::MIN_POSITIVE);
+pub fn offset_origin(p: Vec3, ng: Vec3, err_scale: f32, d: Vec3) -> Vec3 {
+    let delta = (err_scale * SPAWN_REL_OFFSET).max(f32::MIN_POSITIVE);
     let off = ng * delta;
     if d.dot(ng) >= 0.0 {
         p + off

@@ -1,8 +1,8 @@
 //! One-sided diffuse area light on a mesh or a sphere.
 
 use super::{LightSample, LightSampling};
-use crate::geometry::{Shape, ShapeKind, SurfacePoint};
-use crate::math::Rgb;
+use crate::geometry::{Shape, ShapeKind, Sphere, SurfacePoint};
+use crate::math::{Frame, Rgb, PI};
 use crate::sampling::spherical::{
     ray_plane_barycentrics, sample_spherical_triangle, spherical_triangle_area, use_solid_angle,
 };
@@ -21,8 +21,32 @@ pub struct AreaLight {
     pub triangles: Option<AliasTable>,
 }
 
+/// Direction and distance from `ref_p` to a light point, if the light faces `ref_p`
+/// (one-sided emission is decided by the shading normal, as Mitsuba and Nori do).
+#[inline]
+fn facing(ref_p: Vec3, sp: &SurfacePoint) -> Option<(Vec3, f32)> {
+    let d = sp.p - ref_p;
+    let dist = d.length();
+    if !(dist > 0.0) {
+        return None;
+    }
+    let wi = d / dist;
+    (sp.ns.dot(-wi) > 0.0).then_some((wi, dist))
+}
+
+/// Whether a sphere is sampled by its visible cone from `ref_p`: only from outside, and only
+/// for outward normals (from inside, every direction hits it and area sampling is used).
+#[inline]
+fn cone_cos_max(s: &Sphere, ref_p: Vec3) -> Option<f32> {
+    let dc2 = (s.center - ref_p).length_squared();
+    let r2 = s.radius * s.radius;
+    if s.flip_normals || dc2 <= r2 * 1.000_01 {
+        return None;
+    }
+    Some((1.0 - r2 / dc2).max(0.0).sqrt())
+}
+
 impl AreaLight {
-    /// Emission only on the side the shading normal points to, as in Mitsuba and Nori.
     #[inline]
     pub fn le(&self, sp: &SurfacePoint, w: Vec3) -> Rgb {
         if sp.ns.dot(w) > 0.0 {
@@ -32,30 +56,35 @@ impl AreaLight {
         }
     }
 
-    /// Area density to solid angle: p_w = p_A d^2 / |cos theta_light|, zero when the light
-    /// faces away from the reference point.
+    /// Uniform-by-area density converted to solid angle: p_w = d^2 / (A |cos theta_light|).
     #[inline]
-    fn area_to_solid_angle(
-        &self,
-        pdf_area: f32,
-        ref_p: Vec3,
-        sp: &SurfacePoint,
-    ) -> Option<(Vec3, f32, f32)> {
-        let d = sp.p - ref_p;
-        let dist2 = d.length_squared();
-        let dist = dist2.sqrt();
-        if !(dist > 0.0) {
-            return None;
+    fn area_pdf(&self, ref_p: Vec3, sp: &SurfacePoint) -> f32 {
+        match facing(ref_p, sp) {
+            Some((wi, dist)) => {
+                let cos_l = sp.ng.dot(wi).abs();
+                if cos_l > 0.0 {
+                    dist * dist / (self.area * cos_l)
+                } else {
+                    0.0
+                }
+            }
+            None => 0.0,
         }
-        let wi = d / dist;
-        if sp.ns.dot(-wi) <= 0.0 {
-            return None;
-        }
-        let cos_l = sp.ng.dot(-wi).abs();
-        if cos_l == 0.0 {
-            return None;
-        }
-        Some((wi, dist, pdf_area * dist2 / cos_l))
+    }
+
+    #[inline]
+    fn make_sample(&self, ref_p: Vec3, sp: &SurfacePoint, pdf: f32) -> Option<LightSample> {
+        let (wi, dist) = facing(ref_p, sp)?;
+        (pdf > 0.0 && pdf.is_finite()).then_some(LightSample {
+            p: sp.p,
+            ng: sp.ng,
+            err_scale: sp.err_scale,
+            wi,
+            dist,
+            li: self.radiance,
+            pdf,
+            delta: false,
+        })
     }
 
     pub fn sample(
@@ -66,55 +95,42 @@ impl AreaLight {
         u: Vec2,
         mode: LightSampling,
     ) -> Option<LightSample> {
-        let shape = &shapes[self.shape as usize];
-        let sp = match (&shape.kind, mode) {
-            (ShapeKind::Sphere(s), LightSampling::SolidAngle) => {
-                return self.sample_sphere_cone(s, ref_p, u);
+        let sp = match &shapes[self.shape as usize].kind {
+            ShapeKind::Sphere(s) => {
+                if let (LightSampling::SolidAngle, Some(cos_max)) = (mode, cone_cos_max(s, ref_p)) {
+                    let axis = (s.center - ref_p).normalize();
+                    let wi = Frame::from_normal(axis).to_world(square_to_uniform_cone(u, cos_max));
+                    // First intersection with the sphere; clamped for directions that graze it.
+                    let to_c = s.center - ref_p;
+                    let b = to_c.dot(wi);
+                    let disc = (s.radius * s.radius - (to_c - b * wi).length_squared()).max(0.0);
+                    let sp = s.surface_point(ref_p + wi * (b - disc.sqrt()), self.shape);
+                    return self.make_sample(ref_p, &sp, 1.0 / (2.0 * PI * (1.0 - cos_max)));
+                }
+                s.surface_point(
+                    s.center + square_to_uniform_sphere(u) * s.radius,
+                    self.shape,
+                )
             }
-            (ShapeKind::Sphere(s), LightSampling::Area) => s.surface_point(
-                s.center + square_to_uniform_sphere(u) * s.radius,
-                self.shape,
-            ),
-            (ShapeKind::Mesh(m), mode) => {
+            ShapeKind::Mesh(m) => {
                 let table = self.triangles.as_ref()?;
                 let tri = table.sample(u_prim);
                 if mode == LightSampling::SolidAngle {
                     let v = m.vertices(tri);
                     if let Some((w, pdf)) = sample_spherical_triangle(ref_p, v, u) {
-                        let b = ray_plane_barycentrics(ref_p, w, v)?;
-                        let sp = m.surface_point(tri, b, self.shape);
-                        let d = sp.p - ref_p;
-                        let dist = d.length();
-                        let wi = d / dist;
-                        if !(dist > 0.0) || sp.ns.dot(-wi) <= 0.0 {
-                            return None;
-                        }
-                        return Some(LightSample {
-                            p: sp.p,
-                            ng: sp.ng,
-                            wi,
-                            dist,
-                            li: self.radiance,
-                            pdf: table.pmf(tri) * pdf,
-                            delta: false,
-                        });
+                        let sp =
+                            m.surface_point(tri, ray_plane_barycentrics(ref_p, w, v)?, self.shape);
+                        return self.make_sample(ref_p, &sp, table.pmf(tri) * pdf);
                     }
                 }
                 m.surface_point(tri, square_to_uniform_triangle(u), self.shape)
             }
         };
-        let (wi, dist, pdf) = self.area_to_solid_angle(1.0 / self.area, ref_p, &sp)?;
-        Some(LightSample {
-            p: sp.p,
-            ng: sp.ng,
-            wi,
-            dist,
-            li: self.radiance,
-            pdf,
-            delta: false,
-        })
+        self.make_sample(ref_p, &sp, self.area_pdf(ref_p, &sp))
     }
 
+    /// The density `sample` has for the light point `sp`; it must make the same choices
+    /// (cone or area, spherical triangle or area fallback) from the same inputs.
     pub fn pdf(
         &self,
         shapes: &[Shape],
@@ -122,98 +138,31 @@ impl AreaLight {
         sp: &SurfacePoint,
         mode: LightSampling,
     ) -> f32 {
-        match (&shapes[self.shape as usize].kind, mode) {
-            (ShapeKind::Sphere(s), LightSampling::SolidAngle) => {
-                return self.pdf_sphere_cone(s, ref_p, sp)
-            }
-            (ShapeKind::Mesh(m), LightSampling::SolidAngle) => {
-                // Must make the same per-triangle choice as `sample`: solid angle when in range.
-                let omega = spherical_triangle_area(ref_p, m.vertices(sp.prim as usize));
-                if use_solid_angle(omega) {
-                    let wi = (sp.p - ref_p).normalize_or_zero();
-                    if sp.ns.dot(-wi) <= 0.0 {
-                        return 0.0;
+        if mode == LightSampling::SolidAngle {
+            match &shapes[self.shape as usize].kind {
+                ShapeKind::Sphere(s) => {
+                    if let Some(cos_max) = cone_cos_max(s, ref_p) {
+                        return match facing(ref_p, sp) {
+                            Some(_) => 1.0 / (2.0 * PI * (1.0 - cos_max)),
+                            None => 0.0,
+                        };
                     }
-                    let pmf = self
-                        .triangles
-                        .as_ref()
-                        .map_or(0.0, |t| t.pmf(sp.prim as usize));
-                    return pmf / omega;
+                }
+                ShapeKind::Mesh(m) => {
+                    let omega = spherical_triangle_area(ref_p, m.vertices(sp.prim as usize));
+                    if use_solid_angle(omega) {
+                        let pmf = self
+                            .triangles
+                            .as_ref()
+                            .map_or(0.0, |t| t.pmf(sp.prim as usize));
+                        return match facing(ref_p, sp) {
+                            Some(_) => pmf / omega,
+                            None => 0.0,
+                        };
+                    }
                 }
             }
-            _ => {}
         }
-        self.area_to_solid_angle(1.0 / self.area, ref_p, sp)
-            .map_or(0.0, |x| x.2)
-    }
-
-    /// Uniform sampling of the cone of directions the sphere subtends; outside the sphere only
-    /// (from inside every direction hits it, and area sampling is used instead).
-    fn sample_sphere_cone(
-        &self,
-        s: &crate::geometry::Sphere,
-        ref_p: Vec3,
-        u: Vec2,
-    ) -> Option<LightSample> {
-        let to_c = s.center - ref_p;
-        let dc2 = to_c.length_squared();
-        let r2 = s.radius * s.radius;
-        if dc2 <= r2 * 1.000_01 || s.flip_normals {
-            let sp = s.surface_point(
-                s.center + square_to_uniform_sphere(u) * s.radius,
-                self.shape,
-            );
-            let (wi, dist, pdf) = self.area_to_solid_angle(1.0 / self.area, ref_p, &sp)?;
-            return Some(LightSample {
-                p: sp.p,
-                ng: sp.ng,
-                wi,
-                dist,
-                li: self.radiance,
-                pdf,
-                delta: false,
-            });
-        }
-        let dc = dc2.sqrt();
-        let sin2_max = r2 / dc2;
-        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
-        let frame = crate::math::Frame::from_normal(to_c / dc);
-        let wi = frame
-            .to_world(square_to_uniform_cone(u, cos_max))
-            .normalize();
-        // Nearest intersection with the sphere along wi (clamped for directions that graze it).
-        let b = to_c.dot(wi);
-        let disc = (r2 - (to_c - b * wi).length_squared()).max(0.0);
-        let dist = b - disc.sqrt();
-        let sp = s.surface_point(ref_p + wi * dist, self.shape);
-        let pdf = 1.0 / (2.0 * crate::math::PI * (1.0 - cos_max));
-        if !pdf.is_finite() || sp.ns.dot(-wi) <= 0.0 {
-            return None;
-        }
-        Some(LightSample {
-            p: sp.p,
-            ng: sp.ng,
-            wi,
-            dist: (sp.p - ref_p).length(),
-            li: self.radiance,
-            pdf,
-            delta: false,
-        })
-    }
-
-    fn pdf_sphere_cone(&self, s: &crate::geometry::Sphere, ref_p: Vec3, sp: &SurfacePoint) -> f32 {
-        let dc2 = (s.center - ref_p).length_squared();
-        let r2 = s.radius * s.radius;
-        if dc2 <= r2 * 1.000_01 || s.flip_normals {
-            return self
-                .area_to_solid_angle(1.0 / self.area, ref_p, sp)
-                .map_or(0.0, |x| x.2);
-        }
-        let wi = (sp.p - ref_p).normalize_or_zero();
-        if sp.ns.dot(-wi) <= 0.0 {
-            return 0.0;
-        }
-        let cos_max = (1.0 - r2 / dc2).max(0.0).sqrt();
-        1.0 / (2.0 * crate::math::PI * (1.0 - cos_max))
+        self.area_pdf(ref_p, sp)
     }
 }

@@ -22,9 +22,10 @@ pub enum LightSampling {
 /// A point drawn on an emitter as seen from a reference point.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSample {
-    /// Point on the light and its geometric normal (for spawning the shadow ray).
+    /// Point on the light, its geometric normal and error scale (for the shadow ray's end).
     pub p: Vec3,
     pub ng: Vec3,
+    pub err_scale: f32,
     /// Unit direction from the reference point to `p`, and the distance.
     pub wi: Vec3,
     pub dist: f32,
@@ -83,6 +84,7 @@ impl Emitter {
                 Some(LightSample {
                     p: pl.position,
                     ng: -d / dist,
+                    err_scale: 0.0,
                     wi: d / dist,
                     dist,
                     li: pl.intensity / dist2,

@@ -1,6 +1,6 @@
 //! One compressed wide BVH (obvhs CwBvh) over every triangle and sphere of the scene.
 
-use super::shape::{intersect_sphere, intersect_triangle, Shape, ShapeKind};
+use super::shape::{intersect_sphere, Shape, ShapeKind, WatertightRay};
 use super::{Hit, Ray};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::{aabb::Aabb, cwbvh::CwBvh, ray::RayHit, BvhBuildParams};
@@ -9,12 +9,17 @@ use std::time::Duration;
 /// Primitive data stored in BVH leaf order, so the traversal callback indexes it directly.
 #[derive(Clone, Copy, Debug)]
 enum Prim {
-    Tri { v0: Vec3, e1: Vec3, e2: Vec3 },
+    Tri { v: [Vec3; 3] },
     Sphere { c: Vec3, r: f32 },
 }
 
+/// The BVH works in a copy of the scene scaled by a power of two (`scale`) so that the scene
+/// spans about 2^20 units. obvhs culls boxes entered closer than an absolute t of 1e-4
+/// (`cwbvh::node::EPSILON`); in the scaled space that is ~1e-10 of the scene at any scene
+/// scale. Power-of-two scaling is exact, so every hit is the same as in the original space.
 pub struct Accel {
     bvh: Option<CwBvh>,
+    scale: f32,
     prims: Vec<Prim>,
     /// (shape index, triangle index within the shape) per primitive, in leaf order.
     refs: Vec<(u32, u32)>,
@@ -23,6 +28,18 @@ pub struct Accel {
 impl Accel {
     /// Builds over all shapes; zero-area triangles are left out since no ray can hit them.
     pub fn build(shapes: &[Shape]) -> Accel {
+        let magnitude = shapes
+            .iter()
+            .map(|s| match &s.kind {
+                ShapeKind::Mesh(m) => m.bounds_scale(),
+                ShapeKind::Sphere(s) => crate::math::max_abs(s.center) + s.radius,
+            })
+            .fold(0.0f32, f32::max);
+        let scale = if magnitude > 0.0 && magnitude.is_finite() {
+            2f32.powi((20 - magnitude.log2().ceil() as i32).clamp(-100, 100))
+        } else {
+            1.0
+        };
         let mut prims = Vec::new();
         let mut refs = Vec::new();
         let mut aabbs = Vec::new();
@@ -31,23 +48,21 @@ impl Accel {
                 ShapeKind::Mesh(m) => {
                     for ti in 0..m.indices.len() {
                         let [a, b, c] = m.vertices(ti);
-                        let (e1, e2) = (b - a, c - a);
-                        if e1.cross(e2).length_squared() == 0.0 {
+                        if (b - a).cross(c - a).length_squared() == 0.0 {
                             continue;
                         }
-                        prims.push(Prim::Tri { v0: a, e1, e2 });
+                        let (a, b, c) = (a * scale, b * scale, c * scale);
+                        prims.push(Prim::Tri { v: [a, b, c] });
                         refs.push((si as u32, ti as u32));
                         aabbs.push(Aabb::from_points(&[a.into(), b.into(), c.into()]));
                     }
                 }
                 ShapeKind::Sphere(s) => {
-                    prims.push(Prim::Sphere {
-                        c: s.center,
-                        r: s.radius,
-                    });
+                    let (c, r) = (s.center * scale, s.radius * scale);
+                    prims.push(Prim::Sphere { c, r });
                     refs.push((si as u32, 0));
-                    let r = Vec3A::splat(s.radius);
-                    let c: Vec3A = s.center.into();
+                    let r = Vec3A::splat(r);
+                    let c: Vec3A = c.into();
                     aabbs.push(Aabb::new(c - r, c + r));
                 }
             }
@@ -55,6 +70,7 @@ impl Accel {
         if prims.is_empty() {
             return Accel {
                 bvh: None,
+                scale,
                 prims,
                 refs,
             };
@@ -74,6 +90,7 @@ impl Accel {
             .collect();
         Accel {
             bvh: Some(bvh),
+            scale,
             prims,
             refs,
         }
@@ -84,11 +101,11 @@ impl Accel {
     }
 
     #[inline(always)]
-    fn prim_t(&self, i: usize, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> f32 {
+    fn prim_t(&self, i: usize, wr: &WatertightRay, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> f32 {
         match self.prims[i] {
-            Prim::Tri { v0, e1, e2 } => {
-                intersect_triangle(o, d, tmin, tmax, v0, e1, e2).map_or(f32::INFINITY, |h| h.0)
-            }
+            Prim::Tri { v: [a, b, c] } => wr
+                .intersect(a, b, c, tmin, tmax)
+                .map_or(f32::INFINITY, |h| h.0),
             Prim::Sphere { c, r } => {
                 intersect_sphere(o, d, tmin, tmax, c, r).unwrap_or(f32::INFINITY)
             }
@@ -98,27 +115,31 @@ impl Accel {
     /// Closest hit within the ray's interval.
     pub fn intersect(&self, ray: &Ray, shapes: &[Shape]) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
-        let r = obvhs::ray::Ray::new(ray.o.into(), ray.d.into(), ray.tmin, ray.tmax);
+        let k = self.scale;
+        let (o, d, tmin) = (ray.o * k, ray.d, ray.tmin * k);
+        let r = obvhs::ray::Ray::new(o.into(), d.into(), tmin, ray.tmax * k);
         let mut hit = RayHit::none();
-        let (o, d, tmin) = (ray.o, ray.d, ray.tmin);
-        let found = bvh.ray_traverse(r, &mut hit, |r, i| self.prim_t(i, o, d, tmin, r.tmax));
+        let wr = WatertightRay::new(o, d);
+        let found = bvh.ray_traverse(r, &mut hit, |r, i| self.prim_t(i, &wr, o, d, tmin, r.tmax));
         if !found {
             return None;
         }
         let i = hit.primitive_id as usize;
         let (shape, local) = self.refs[i];
         let sp = match (self.prims[i], &shapes[shape as usize].kind) {
-            (Prim::Tri { v0, e1, e2 }, ShapeKind::Mesh(m)) => {
+            (Prim::Tri { v: [a, b, c] }, ShapeKind::Mesh(m)) => {
                 // Recompute barycentrics for the winner only, not inside the traversal.
-                let (_, u, v) =
-                    intersect_triangle(o, d, f32::NEG_INFINITY, f32::INFINITY, v0, e1, e2)
-                        .unwrap_or((hit.t, 1.0 / 3.0, 1.0 / 3.0));
+                let (_, u, v) = wr
+                    .intersect(a, b, c, f32::NEG_INFINITY, f32::INFINITY)
+                    .unwrap_or((hit.t, 1.0 / 3.0, 1.0 / 3.0));
                 m.surface_point(local as usize, Vec2::new(u, v), shape)
             }
-            (Prim::Sphere { .. }, ShapeKind::Sphere(s)) => s.surface_point(o + d * hit.t, shape),
+            (Prim::Sphere { .. }, ShapeKind::Sphere(s)) => {
+                s.surface_point(ray.o + ray.d * (hit.t / k), shape)
+            }
             _ => unreachable!("primitive and shape kinds always agree"),
         };
-        Some(Hit { t: hit.t, sp })
+        Some(Hit { t: hit.t / k, sp })
     }
 
     /// True if anything blocks the ray within its interval.
@@ -126,9 +147,11 @@ impl Accel {
         let Some(bvh) = self.bvh.as_ref() else {
             return false;
         };
-        let r = obvhs::ray::Ray::new(ray.o.into(), ray.d.into(), ray.tmin, ray.tmax);
-        let (o, d, tmin, tmax) = (ray.o, ray.d, ray.tmin, ray.tmax);
-        !bvh.ray_traverse_miss(r, |_, i| self.prim_t(i, o, d, tmin, tmax))
+        let k = self.scale;
+        let (o, d, tmin, tmax) = (ray.o * k, ray.d, ray.tmin * k, ray.tmax * k);
+        let r = obvhs::ray::Ray::new(o.into(), d.into(), tmin, tmax);
+        let wr = WatertightRay::new(o, d);
+        !bvh.ray_traverse_miss(r, |_, i| self.prim_t(i, &wr, o, d, tmin, tmax))
     }
 }
 
@@ -188,9 +211,12 @@ mod tests {
             let o = Vec3::new(rng.next_f32() * 1.4 - 0.2, rng.next_f32() * 1.4 - 0.2, 2.0);
             let d = Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, -1.0).normalize();
             let ray = Ray::new(o, d);
+            let ko = o * accel.scale;
+            let wr = WatertightRay::new(ko, d);
             let brute = (0..accel.prims.len())
-                .map(|i| accel.prim_t(i, o, d, 0.0, f32::INFINITY))
-                .fold(f32::INFINITY, f32::min);
+                .map(|i| accel.prim_t(i, &wr, ko, d, 0.0, f32::INFINITY))
+                .fold(f32::INFINITY, f32::min)
+                / accel.scale;
             match accel.intersect(&ray, &shapes) {
                 Some(h) => {
                     hits += 1;

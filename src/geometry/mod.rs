@@ -39,6 +39,17 @@ pub struct SurfacePoint {
     pub shape: u32,
     /// Triangle index within the shape (0 for spheres).
     pub prim: u32,
+    /// Magnitude of the values `p` was computed from (vertices, sphere centre and radius):
+    /// its rounding error is proportional to this, not to |p|.
+    pub err_scale: f32,
+}
+
+impl SurfacePoint {
+    /// Origin for a ray leaving this point in direction `d`, clear of the surface.
+    #[inline]
+    pub fn spawn_origin(&self, d: Vec3) -> Vec3 {
+        crate::math::offset_origin(self.p, self.ng, self.err_scale, d)
+    }
 }
 
 #[derive(Clone, Copy, Debug)]

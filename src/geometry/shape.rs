@@ -70,12 +70,14 @@ impl Mesh {
                 }
             }
         }
+        let err_scale = b0.abs() * max_abs(a) + b.x.abs() * max_abs(v1) + b.y.abs() * max_abs(v2);
         SurfacePoint {
             p,
             ng: ngo,
             ns,
             shape,
             prim: tri as u32,
+            err_scale,
         }
     }
 
@@ -105,43 +107,122 @@ impl Sphere {
             ns: n,
             shape,
             prim: 0,
+            err_scale: max_abs(self.center) + self.radius,
         }
     }
 }
 
-/// Möller-Trumbore; returns (t, b1, b2) for hits strictly inside (tmin, tmax).
-#[inline(always)]
+/// Per-ray setup of the watertight ray-triangle test (Woop, Benthin and Wald 2013): the ray
+/// is mapped to +z by a permutation and shear, so neighbouring triangles evaluate their
+/// shared edge with identical arithmetic and no ray slips between them.
+#[derive(Clone, Copy, Debug)]
+pub struct WatertightRay {
+    o: Vec3,
+    k: [usize; 3],
+    shear: Vec3,
+}
+
+impl WatertightRay {
+    #[inline(always)]
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        let a = d.abs();
+        let kz = if a.x > a.y {
+            if a.x > a.z {
+                0
+            } else {
+                2
+            }
+        } else if a.y > a.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        // Keep the winding (and so the sign of the determinant) of the original triangle.
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let dz = d[kz];
+        WatertightRay {
+            o,
+            k: [kx, ky, kz],
+            shear: Vec3::new(-d[kx] / dz, -d[ky] / dz, 1.0 / dz),
+        }
+    }
+
+    /// (t, b1, b2) for a hit strictly inside (tmin, tmax).
+    #[inline(always)]
+    pub fn intersect(
+        &self,
+        v0: Vec3,
+        v1: Vec3,
+        v2: Vec3,
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<(f32, f32, f32)> {
+        let [kx, ky, kz] = self.k;
+        let (a, b, c) = (v0 - self.o, v1 - self.o, v2 - self.o);
+        let (sx, sy) = (self.shear.x, self.shear.y);
+        let (ax, ay) = (a[kx] + sx * a[kz], a[ky] + sy * a[kz]);
+        let (bx, by) = (b[kx] + sx * b[kz], b[ky] + sy * b[kz]);
+        let (cx, cy) = (c[kx] + sx * c[kz], c[ky] + sy * c[kz]);
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            // Exactly on an edge in f32: decide in f64 so both neighbours agree.
+            let f =
+                |p: f32, q: f32, r: f32, s: f32| (p as f64 * q as f64 - r as f64 * s as f64) as f32;
+            u = f(cx, by, cy, bx);
+            v = f(ax, cy, ay, cx);
+            w = f(bx, ay, by, ax);
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return None;
+        }
+        let sz = self.shear.z;
+        let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
+        let t_scaled = u * az + v * bz + w * cz;
+        let inv = 1.0 / det;
+        let t = t_scaled * inv;
+        if !(t > tmin && t < tmax) {
+            return None;
+        }
+        // pbrt-v4's conservative bound on the rounding error of t: a hit closer than it may be
+        // the ray's own surface, so it is rejected (this is what makes small spawn offsets safe).
+        let gamma = |n: f32| n * f32::EPSILON * 0.5 / (1.0 - n * f32::EPSILON * 0.5);
+        let max_z = az.abs().max(bz.abs()).max(cz.abs());
+        let max_x = ax.abs().max(bx.abs()).max(cx.abs());
+        let max_y = ay.abs().max(by.abs()).max(cy.abs());
+        let delta_z = gamma(3.0) * max_z;
+        let delta_x = gamma(5.0) * (max_x + max_z);
+        let delta_y = gamma(5.0) * (max_y + max_z);
+        let delta_e = 2.0 * (gamma(2.0) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let max_e = u.abs().max(v.abs()).max(w.abs());
+        let delta_t =
+            3.0 * (gamma(3.0) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv.abs();
+        if t <= delta_t {
+            return None;
+        }
+        Some((t, v * inv, w * inv))
+    }
+}
+
+/// Convenience form of the watertight test for a single triangle.
+#[inline]
 pub fn intersect_triangle(
     o: Vec3,
     d: Vec3,
     tmin: f32,
     tmax: f32,
-    v0: Vec3,
-    e1: Vec3,
-    e2: Vec3,
+    v: [Vec3; 3],
 ) -> Option<(f32, f32, f32)> {
-    let pvec = d.cross(e2);
-    let det = e1.dot(pvec);
-    if det == 0.0 || !det.is_finite() {
-        return None;
-    }
-    let inv = 1.0 / det;
-    let tvec = o - v0;
-    let u = tvec.dot(pvec) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return None;
-    }
-    let qvec = tvec.cross(e1);
-    let v = d.dot(qvec) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    let t = e2.dot(qvec) * inv;
-    if t > tmin && t < tmax {
-        Some((t, u, v))
-    } else {
-        None
-    }
+    WatertightRay::new(o, d).intersect(v[0], v[1], v[2], tmin, tmax)
 }
 
 /// Nearest root of |o + t d - c| = r inside (tmin, tmax). The discriminant is computed from
@@ -181,14 +262,57 @@ mod tests {
 
     #[test]
     fn triangle_hit_and_barycentrics() {
-        let (v0, v1, v2) = (Vec3::ZERO, Vec3::X, Vec3::Y);
+        let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
         let o = Vec3::new(0.25, 0.5, 1.0);
-        let (t, u, v) = intersect_triangle(o, -Vec3::Z, 0.0, 10.0, v0, v1 - v0, v2 - v0).unwrap();
+        let (t, u, v) = intersect_triangle(o, -Vec3::Z, 0.0, 10.0, tri).unwrap();
         assert!((t - 1.0).abs() < 1e-6 && (u - 0.25).abs() < 1e-6 && (v - 0.5).abs() < 1e-6);
-        assert!(intersect_triangle(o, Vec3::Z, 0.0, 10.0, v0, v1, v2).is_none());
-        assert!(intersect_triangle(o, -Vec3::Z, 0.0, 0.5, v0, v1, v2).is_none());
+        assert!(intersect_triangle(o, Vec3::Z, 0.0, 10.0, tri).is_none());
+        assert!(intersect_triangle(o, -Vec3::Z, 0.0, 0.5, tri).is_none());
         let outside = Vec3::new(0.8, 0.8, 1.0);
-        assert!(intersect_triangle(outside, -Vec3::Z, 0.0, 10.0, v0, v1, v2).is_none());
+        assert!(intersect_triangle(outside, -Vec3::Z, 0.0, 10.0, tri).is_none());
+        // Seen from below, with a reversed winding, and along other axes: still hit.
+        let (t, ..) =
+            intersect_triangle(Vec3::new(0.25, 0.5, -2.0), Vec3::Z, 0.0, 10.0, tri).unwrap();
+        assert!((t - 2.0).abs() < 1e-6);
+        assert!(intersect_triangle(o, -Vec3::Z, 0.0, 10.0, [tri[0], tri[2], tri[1]]).is_some());
+        let side = Vec3::new(-1.0, 0.2, 0.0);
+        assert!(intersect_triangle(
+            Vec3::new(3.0, 0.05, 0.3),
+            side.normalize(),
+            0.0,
+            10.0,
+            [Vec3::ZERO, Vec3::Y, Vec3::Z]
+        )
+        .is_some());
+    }
+
+    /// The defect that motivated the watertight test: rays aimed at the shared diagonal of
+    /// two huge coplanar triangles must hit one of them, every time.
+    #[test]
+    fn no_ray_slips_through_a_shared_edge() {
+        let s = 1e3;
+        let p = [
+            Vec3::new(-s, -s, 0.0),
+            Vec3::new(s, -s, 0.0),
+            Vec3::new(s, s, 0.0),
+            Vec3::new(-s, s, 0.0),
+        ];
+        let tris = [[p[0], p[1], p[2]], [p[0], p[2], p[3]]];
+        let eye = Vec3::new(3.0, 0.0, 1.0);
+        let mut rng = crate::rng::Rng::new(4, 4);
+        for _ in 0..100_000 {
+            let x = (rng.next_f32() - 0.5) * 1e-3;
+            let target = Vec3::new(x, x + (rng.next_f32() - 0.5) * 1e-6, 0.0);
+            let d = (target - eye).normalize();
+            let hits = tris
+                .iter()
+                .filter(|t| intersect_triangle(eye, d, 0.0, f32::INFINITY, **t).is_some())
+                .count();
+            assert!(
+                hits >= 1,
+                "ray towards {target} slipped through the shared edge"
+            );
+        }
     }
 
     #[test]

@@ -9,7 +9,7 @@ use super::Strategy;
 use crate::bsdf::Material;
 use crate::emitter::{EmitterSelector, LightSample};
 use crate::geometry::{Ray, SurfacePoint};
-use crate::math::{offset_origin, Frame, Rgb};
+use crate::math::{Frame, Rgb};
 use crate::rng::Rng;
 use crate::scene::desc::{Heuristic, StrategyKind};
 use crate::scene::Scene;
@@ -144,8 +144,7 @@ impl<'a> Direct<'a> {
         if f == Rgb::ZERO || ls.li == Rgb::ZERO {
             return Rgb::ZERO;
         }
-        let to_ng = if ls.delta { None } else { Some(ls.ng) };
-        if !scene.visible(&sh.sp, ls.p, to_ng) {
+        if !scene.visible(&sh.sp, &ls) {
             return Rgb::ZERO;
         }
         let p_light = pmf * ls.pdf;
@@ -165,7 +164,7 @@ impl<'a> Direct<'a> {
             return Rgb::ZERO;
         };
         let d = sh.frame.to_world(bs.wo);
-        let ray = Ray::new(offset_origin(sh.sp.p, sh.sp.ng, d), d);
+        let ray = Ray::new(sh.sp.spawn_origin(d), d);
         let Some(hit) = scene.intersect(&ray) else {
             return Rgb::ZERO;
         };

@@ -7,6 +7,7 @@ use crate::emitter::{EmitterSelection, LightSampling};
 use crate::render::{render, RenderOutput, RenderSettings};
 use crate::scene::desc::{Heuristic, StrategyKind};
 use crate::scene::{fixtures, Scene};
+use glam::Vec3;
 use statrs::distribution::{ContinuousCDF, Normal};
 
 pub(crate) fn all_strategies() -> Vec<Strategy> {
@@ -143,4 +144,78 @@ fn same_seed_same_bytes_for_any_thread_count() {
         bytes(&render(&scene, s, &c)),
         "a different seed must change the image"
     );
+}
+
+/// Lambert: a sphere of radiance L, radius r, centre at distance d and angle theta from the
+/// receiver's normal, entirely above the horizon, gives E = pi L (r/d)^2 cos(theta).
+#[test]
+fn sphere_light_matches_closed_form_for_every_strategy() {
+    let (albedo, radiance) = (0.7f32, 3.0f32);
+    let cases = [
+        (Vec3::new(0.0, 0.0, 2.0), 0.5, Vec3::new(3.0, 0.0, 1.0)),
+        (Vec3::new(1.5, 0.5, 1.0), 0.3, Vec3::new(-2.0, 0.0, 2.0)),
+        (Vec3::new(0.0, 0.2, 0.25), 0.2, Vec3::new(0.0, -3.0, 3.0)),
+    ];
+    let strategies = all_strategies();
+    let zc = z_critical(0.01, strategies.len() * cases.len());
+    for (c, r, eye) in cases {
+        let d = c.length();
+        let expected = (albedo as f64 / std::f64::consts::PI)
+            * std::f64::consts::PI
+            * radiance as f64
+            * (r as f64 / d as f64).powi(2)
+            * (c.z / d) as f64;
+        let scene = Scene::build(fixtures::light_over_floor(
+            fixtures::sphere_light(c, r, radiance),
+            albedo,
+            Vec3::ZERO,
+            eye,
+        ))
+        .unwrap();
+        for s in &strategies {
+            // BSDF sampling of a small light is noisy: give it more samples.
+            let spp = if s.kind == StrategyKind::Bsdf {
+                200_000
+            } else {
+                20_000
+            };
+            let out = render(&scene, *s, &settings(spp, 3));
+            assert_eq!(out.non_finite_samples, 0);
+            let (z, mean) = image_z(&out, expected);
+            assert!(
+                z.abs() < zc,
+                "{} sphere {c} r {r}: {mean} vs {expected}, z = {z:.2} (critical {zc:.2})",
+                s.label()
+            );
+        }
+    }
+}
+
+/// Self-intersection and shadow leaks at any scene scale: the furnace, scaled by 1e-3 .. 1e4
+/// and moved away from the origin (where absolute rounding error grows), still renders 1 + a.
+#[test]
+fn furnace_holds_at_every_scene_scale() {
+    let albedo = 0.5;
+    let scales = [1e-3f32, 1e-1, 1e2, 1e4];
+    let strategies = [all_strategies()[1], all_strategies()[6]];
+    let zc = z_critical(0.01, scales.len() * 2 * strategies.len());
+    for scale in scales {
+        for shift in [0.0f32, 10.0] {
+            let mut desc = fixtures::furnace(albedo, true, 16);
+            let m = glam::Mat4::from_translation(Vec3::splat(shift * scale))
+                * glam::Mat4::from_scale(Vec3::splat(scale));
+            fixtures::transform(&mut desc, m);
+            let scene = Scene::build(desc).unwrap();
+            for s in strategies {
+                let out = render(&scene, s, &settings(32, 5));
+                assert_eq!(out.non_finite_samples, 0);
+                let (z, mean) = image_z(&out, 1.0 + albedo as f64);
+                assert!(
+                    z.abs() < zc,
+                    "{} scale {scale} shift {shift}: {mean}, z = {z:.2}",
+                    s.label()
+                );
+            }
+        }
+    }
 }

@@ -186,16 +186,7 @@ mod tests {
             for _ in 0..n {
                 let (w, pdf) = sample_spherical_triangle(p, v, rng.next_2d()).unwrap();
                 s += 1.0 / pdf as f64;
-                let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
-                let hit = crate::geometry::shape::intersect_triangle(
-                    p,
-                    w,
-                    0.0,
-                    f32::INFINITY,
-                    v[0],
-                    e1,
-                    e2,
-                );
+                let hit = crate::geometry::shape::intersect_triangle(p, w, 0.0, f32::INFINITY, v);
                 let b = ray_plane_barycentrics(p, w, v).unwrap();
                 assert!(
                     hit.is_some() || b.x.min(b.y).min(1.0 - b.x - b.y) < 1e-4,

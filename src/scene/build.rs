@@ -4,11 +4,10 @@
 use super::desc::{BsdfDesc, SceneDesc, ShapeGeometry};
 use crate::bsdf::{BsdfKind, Diffuse, Material};
 use crate::camera::Camera;
-use crate::emitter::{AreaLight, Emitter, PointLight};
+use crate::emitter::{AreaLight, Emitter, LightSample, PointLight};
 use crate::geometry::{Accel, Hit, Mesh, Ray, Shape, ShapeKind, Sphere, SurfacePoint};
 use crate::math::{offset_origin, Rgb};
 use crate::sampling::AliasTable;
-use glam::Vec3;
 use std::fmt;
 
 /// A scene the renderer cannot use, with the element it came from.
@@ -213,11 +212,12 @@ impl Scene {
     /// their surfaces and the shadow ray stops just short of the light, so neither the
     /// receiver nor the light itself counts as a blocker.
     #[inline]
-    pub fn visible(&self, from: &SurfacePoint, to_p: Vec3, to_ng: Option<Vec3>) -> bool {
-        let o = offset_origin(from.p, from.ng, to_p - from.p);
-        let target = match to_ng {
-            Some(n) => offset_origin(to_p, n, o - to_p),
-            None => to_p,
+    pub fn visible(&self, from: &SurfacePoint, ls: &LightSample) -> bool {
+        let o = from.spawn_origin(ls.p - from.p);
+        let target = if ls.delta {
+            ls.p
+        } else {
+            offset_origin(ls.p, ls.ng, ls.err_scale, o - ls.p)
         };
         let ray = Ray {
             o,

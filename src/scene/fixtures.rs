@@ -61,18 +61,9 @@ pub fn diffuse(a: f32) -> BsdfDesc {
     }
 }
 
-/// A one-sided triangle light (emitting towards the side its counter-clockwise winding
-/// faces) over a large diffuse floor z = 0, and a one-pixel camera with a tiny field of view
-/// looking straight down at the receiver point `x` on the floor, from `height` above it.
-pub fn triangle_over_floor(
-    tri: [Vec3; 3],
-    radiance: f32,
-    albedo: f32,
-    x: Vec3,
-    height: f32,
-) -> SceneDesc {
-    let s = 1e3;
-    let floor = mesh(
+fn floor(albedo: f32) -> ShapeDesc {
+    let s = 50.0;
+    mesh(
         vec![
             Vec3::new(-s, -s, 0.0),
             Vec3::new(s, -s, 0.0),
@@ -82,15 +73,52 @@ pub fn triangle_over_floor(
         vec![[0, 1, 2], [0, 2, 3]],
         diffuse(albedo),
         None,
-    );
+    )
+}
+
+/// A large diffuse floor z = 0 (normal +z) under `light`, seen by a one-pixel camera with a
+/// tiny field of view that looks at the receiver point `x` from `eye`.
+pub fn light_over_floor(light: ShapeDesc, albedo: f32, x: Vec3, eye: Vec3) -> SceneDesc {
+    let up = if (eye - x).cross(Vec3::Y).length() > 1e-3 {
+        Vec3::Y
+    } else {
+        Vec3::X
+    };
+    base(look_at(eye, x, up), 1e-3, 1, 1, vec![floor(albedo), light])
+}
+
+/// A one-sided triangle light (emitting towards the side its counter-clockwise winding
+/// faces) over the floor, the receiver `x` seen from straight above.
+pub fn triangle_over_floor(
+    tri: [Vec3; 3],
+    radiance: f32,
+    albedo: f32,
+    x: Vec3,
+    height: f32,
+) -> SceneDesc {
     let light = mesh(
         tri.to_vec(),
         vec![[0, 1, 2]],
         diffuse(0.0),
         Some(Rgb::splat(radiance)),
     );
-    let eye = x + Vec3::Z * height;
-    base(look_at(eye, x, Vec3::Y), 1e-3, 1, 1, vec![floor, light])
+    light_over_floor(light, albedo, x, x + Vec3::Z * height)
+}
+
+/// A spherical light of the given radiance over the floor.
+pub fn sphere_light(center: Vec3, radius: f32, radiance: f32) -> ShapeDesc {
+    ShapeDesc {
+        geometry: ShapeGeometry::Sphere {
+            center,
+            radius,
+            flip_normals: false,
+        },
+        bsdf: diffuse(0.0),
+        emitter: Some(AreaEmitterDesc {
+            radiance: Rgb::splat(radiance),
+        }),
+        origin: "<fixture sphere>".into(),
+    }
 }
 
 /// A closed cube [-1,1]^3 whose inward-facing faces are diffuse (albedo `a`) and emit L = 1.
@@ -169,6 +197,36 @@ pub fn furnace(a: f32, split: bool, width: u32) -> SceneDesc {
         Vec3::Y,
     );
     base(cam, 100.0, width, width, shapes)
+}
+
+/// Applies a transform to the whole scene: geometry, lights and camera.
+pub fn transform(desc: &mut SceneDesc, m: Mat4) {
+    let scale = m.transform_vector3(Vec3::X).length();
+    for s in &mut desc.shapes {
+        match &mut s.geometry {
+            ShapeGeometry::Mesh {
+                positions, normals, ..
+            } => {
+                positions
+                    .iter_mut()
+                    .for_each(|p| *p = m.transform_point3(*p));
+                if let Some(n) = normals {
+                    let nm = m.inverse().transpose();
+                    n.iter_mut()
+                        .for_each(|v| *v = nm.transform_vector3(*v).normalize());
+                }
+            }
+            ShapeGeometry::Sphere { center, radius, .. } => {
+                *center = m.transform_point3(*center);
+                *radius *= scale;
+            }
+        }
+    }
+    for p in &mut desc.point_lights {
+        p.position = m.transform_point3(p.position);
+    }
+    // Clip distances are camera-space depths: the scaled camera matrix scales them already.
+    desc.camera.to_world = m * desc.camera.to_world;
 }
 
 #[cfg(test)]
