@@ -21,11 +21,13 @@ pub struct Chi2Config {
     pub samples: u64,
     /// Significance level for this case; pass `sidak(alpha, cases)` when testing a batch.
     pub threshold: f64,
+    /// The sampler draws from `Rng::new(seed, 0)`, so a run is reproducible.
     pub seed: u64,
     /// Cells expected to receive fewer samples than this are pooled.
     pub min_expected: f64,
-    /// Samples tolerated in cells of expected count 0, as a fraction of N. Nori uses 1e-5
-    /// to forgive f32 rounding at the support's boundary; 0 makes any stray sample fatal.
+    /// Samples tolerated in cells of expected count 0 (an integral below 1e-12 N, i.e.
+    /// numerically nothing), as a fraction of N. Nori uses 1e-5 to forgive f32 rounding at
+    /// the support's boundary; 0 makes any stray sample fatal.
     pub zero_tolerance: f64,
     pub integration: Integration,
 }

@@ -278,3 +278,100 @@ fn chi2_sf_textbook() {
     assert!((chi2_sf(3.841, 1) - 0.05).abs() < 1e-4);
     assert!((chi2_sf(18.307, 10) - 0.05).abs() < 1e-4);
 }
+
+#[test]
+fn refinement_stays_near_edges() {
+    // Budget check: a uniform 5x5-node pass over 51x101 cells with split 2 costs ~0.1 M
+    // evaluations; edges (the cap's rim, the cosine lobe's horizon) may add some millions,
+    // not the 4^8-fold of refining everywhere.
+    let count = |pdf: fn(Vec3) -> f64| {
+        let n = std::cell::Cell::new(0u64);
+        let (grid, _) = cell_integrals(
+            &Sphere::default(),
+            |d| {
+                n.set(n.get() + 1);
+                pdf(d)
+            },
+            &Integration::default(),
+        );
+        (n.get(), grid.sum())
+    };
+    for (name, pdf) in [("cap", cap_pdf as fn(Vec3) -> f64), ("cosine", cosine_pdf)] {
+        let (evals, total) = count(pdf);
+        eprintln!("{name}: {evals} pdf evaluations, integral {total}");
+        assert!(evals < 4_000_000, "{name}: {evals}");
+    }
+}
+
+/// A square area light of side 1 whose centre is 1 above the origin, tilted so its
+/// silhouette crosses the (phi, cos theta) grid along curves; normal faces the origin.
+struct QuadLight {
+    centre: glam::DVec3,
+    normal: glam::DVec3,
+    t: glam::DVec3,
+    b: glam::DVec3,
+}
+
+impl QuadLight {
+    fn new() -> Self {
+        let normal = -glam::DVec3::new(0.3, -0.2, 1.0).normalize();
+        let t = normal.any_orthonormal_vector();
+        QuadLight {
+            centre: glam::DVec3::new(0.2, 0.1, 1.0),
+            normal,
+            t,
+            b: normal.cross(t),
+        }
+    }
+
+    /// Uniform point on the light, returned as the direction towards it.
+    fn sample(&self, rng: &mut Rng) -> Option<Vec3> {
+        let (u, v) = (rng.next_f64() - 0.5, rng.next_f64() - 0.5);
+        Some(
+            (self.centre + u * self.t + v * self.b)
+                .normalize()
+                .as_vec3(),
+        )
+    }
+
+    /// Solid-angle pdf of `sample`: d^2 / (area |cos theta_light|) inside the silhouette.
+    /// With `jacobian = false` it makes the classic mistake of dropping the cosine.
+    fn pdf(&self, d: Vec3, jacobian: bool) -> f64 {
+        let d = d.as_dvec3();
+        let cos_l = -d.dot(self.normal);
+        if cos_l <= 0.0 {
+            return 0.0;
+        }
+        let dist = self.centre.dot(self.normal) / d.dot(self.normal);
+        let q = dist * d - self.centre;
+        if q.dot(self.t).abs() > 0.5 || q.dot(self.b).abs() > 0.5 {
+            return 0.0;
+        }
+        dist * dist / if jacobian { cos_l } else { 1.0 }
+    }
+}
+
+#[test]
+fn area_light_silhouette_passes_and_missing_cosine_fails() {
+    // The light covers ~0.7 sr, about 300 cells, many of them cut by its silhouette.
+    // alpha = 0.01, N = 200k.
+    let light = QuadLight::new();
+    let r = chi2_test(
+        &Sphere::default(),
+        |g| light.sample(g),
+        |d| light.pdf(d, true),
+        &cfg(0.01),
+    );
+    eprintln!("quad light: {}", r.reason);
+    assert!(r.passed(), "{}", r.reason);
+    assert!((r.pdf_integral - 1.0).abs() < 1e-4, "{}", r.pdf_integral);
+    let r = chi2_test(
+        &Sphere::default(),
+        |g| light.sample(g),
+        |d| light.pdf(d, false),
+        &cfg(0.01),
+    );
+    eprintln!("quad light without cos: {}", r.reason);
+    assert!(!r.passed());
+    assert!(r.p_value < 1e-6);
+}
