@@ -277,3 +277,44 @@ fn sphere_cap_solid_angle_values() {
     assert_eq!(sphere_cap_solid_angle(DVec3::ZERO, c, 3.0), 4.0 * PI);
     assert!((cone_solid_angle(-1.0) - 4.0 * PI).abs() < 1e-15);
 }
+
+/// One-sample Monte Carlo estimate of E by uniform area sampling of a triangle light.
+fn area_sampled_irradiance(tri: &[DVec3], n: DVec3, rng: &mut Rng, with_cos_light: bool) -> f64 {
+    let (u1, u2) = (rng.next_f64(), rng.next_f64());
+    let s = u1.sqrt();
+    let y = (1.0 - s) * tri[0] + s * (1.0 - u2) * tri[1] + s * u2 * tri[2];
+    let normal = polygon_normal(tri);
+    let area = normal.length();
+    let d = y;
+    let d2 = d.length_squared();
+    let cos_x = (d.dot(n) / d2.sqrt()).max(0.0);
+    let cos_y = if with_cos_light {
+        (-d.dot(normal) / (area * d2.sqrt())).max(0.0)
+    } else {
+        1.0
+    };
+    cos_x * cos_y / d2 * area
+}
+
+#[test]
+fn monte_carlo_estimates_pass_t_test_against_lambert() {
+    // Nori-style t-test: 100k samples per triangle, two-sided, alpha = 0.01 Sidak-corrected
+    // over the 5 triangles. The same estimator without the light's cosine must fail.
+    use crate::stats::{one_sample_welford, sidak, Welford};
+    let alpha = sidak(0.01, NORI.len());
+    let mut rng = Rng::new(2024, 3);
+    for (i, (tri, _)) in NORI.iter().enumerate() {
+        let tri = verts(tri);
+        let exact = polygon_irradiance(DVec3::ZERO, DVec3::Y, &tri, 1.0).unwrap();
+        let good: Welford = (0..100_000)
+            .map(|_| area_sampled_irradiance(&tri, DVec3::Y, &mut rng, true))
+            .collect();
+        let t = one_sample_welford(&good, exact);
+        eprintln!("polylum{}: t = {:.3}, p = {:.4}", i + 1, t.t, t.p_value);
+        assert!(t.passes(alpha), "polylum{}: {t:?}", i + 1);
+        let bad: Welford = (0..100_000)
+            .map(|_| area_sampled_irradiance(&tri, DVec3::Y, &mut rng, false))
+            .collect();
+        assert!(!one_sample_welford(&bad, exact).passes(alpha));
+    }
+}
