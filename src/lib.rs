@@ -3,6 +3,7 @@
 // `!(x > 0.0)` is how this crate rejects NaN together with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod analytic;
 pub mod bsdf;
 pub mod camera;
 pub mod emitter;
@@ -14,3 +15,4 @@ pub mod render;
 pub mod rng;
 pub mod sampling;
 pub mod scene;
+pub mod stats;

@@ -1,0 +1,318 @@
+//! Pearson chi-square test of a sampler against the pdf it claims (Nori's warptest and
+//! Mitsuba's `ChiSquareTest` in spirit).
+//!
+//! Samples are binned on a [`Domain`]'s grid; expected counts are `N * integral of the pdf
+//! over each cell`, integrated adaptively so sharp support edges stay exact. Cells expected
+//! to get fewer than `min_expected` samples are pooled (Nori's rule). Samples the sampler
+//! fails to produce (`None`) form one more category, "lost", whose expected count is
+//! `N * (1 - integral of the pdf)`: a sampler that fails 10 % of the time passes only if
+//! its pdf integrates to 0.9. The lost category enters the statistic only when samples were
+//! lost, so a tiny integration error in the total cannot fail a lossless sampler.
+
+use super::domain::Domain;
+use super::integrate::{integrate_rect, Integration};
+use crate::rng::Rng;
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+/// Parameters of one chi-square run.
+#[derive(Clone, Copy, Debug)]
+pub struct Chi2Config {
+    /// Number of sampler calls N.
+    pub samples: u64,
+    /// Significance level for this case; pass `sidak(alpha, cases)` when testing a batch.
+    pub threshold: f64,
+    /// The sampler draws from `Rng::new(seed, 0)`, so a run is reproducible.
+    pub seed: u64,
+    /// Cells expected to receive fewer samples than this are pooled.
+    pub min_expected: f64,
+    /// Samples tolerated in cells of expected count 0 (an integral below 1e-12 N, i.e.
+    /// numerically nothing), as a fraction of N. Nori uses 1e-5 to forgive f32 rounding at
+    /// the support's boundary; 0 makes any stray sample fatal.
+    pub zero_tolerance: f64,
+    pub integration: Integration,
+}
+
+impl Default for Chi2Config {
+    fn default() -> Self {
+        Chi2Config {
+            samples: 1_000_000,
+            threshold: 0.01,
+            seed: 0,
+            min_expected: 5.0,
+            zero_tolerance: 1e-5,
+            integration: Integration::default(),
+        }
+    }
+}
+
+/// Verdict of a statistical test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    Pass,
+    Fail,
+}
+
+/// Row-major grid of per-cell values; `row` follows the domain's v parameter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grid {
+    pub cols: usize,
+    pub rows: usize,
+    pub data: Vec<f64>,
+}
+
+impl Grid {
+    pub fn new(cols: usize, rows: usize) -> Self {
+        Grid {
+            cols,
+            rows,
+            data: vec![0.0; cols * rows],
+        }
+    }
+    pub fn get(&self, col: usize, row: usize) -> f64 {
+        self.data[row * self.cols + col]
+    }
+    pub fn sum(&self) -> f64 {
+        self.data.iter().sum()
+    }
+}
+
+/// Everything a report or heat map needs about one run.
+#[derive(Clone, Debug)]
+pub struct Chi2Result {
+    pub domain: &'static str,
+    pub statistic: f64,
+    pub dof: usize,
+    pub p_value: f64,
+    pub threshold: f64,
+    pub verdict: Verdict,
+    /// Why it failed, or a one-line summary when it passed.
+    pub reason: String,
+    pub observed: Grid,
+    pub expected: Grid,
+    pub samples: u64,
+    /// Sampler calls that returned None.
+    pub lost: u64,
+    /// Samples outside the domain (never binned; any makes the test fail).
+    pub outside: u64,
+    /// Integral of the pdf over the domain: 1 for a sampler that never fails.
+    pub pdf_integral: f64,
+}
+
+impl Chi2Result {
+    pub fn passed(&self) -> bool {
+        self.verdict == Verdict::Pass
+    }
+}
+
+/// Integrates `pdf` over every cell: the expected fraction of samples per cell.
+/// Negative or NaN pdf values are counted (and treated as 0) so the caller can fail on them.
+pub fn cell_integrals<D: Domain>(
+    domain: &D,
+    pdf: impl Fn(D::Point) -> f64,
+    cfg: &Integration,
+) -> (Grid, u64) {
+    let (cols, rows) = domain.resolution();
+    let ([u0, u1], [v0, v1]) = domain.bounds();
+    let (du, dv) = ((u1 - u0) / cols as f64, (v1 - v0) / rows as f64);
+    let jac = domain.jacobian();
+    let mut bad = 0u64;
+    let mut f = |u: f64, v: f64| match domain.point(u, v) {
+        None => 0.0,
+        Some(p) => {
+            let x = pdf(p);
+            if x.is_nan() || x < 0.0 {
+                bad += 1;
+                0.0
+            } else {
+                x * jac
+            }
+        }
+    };
+    // Errors far below one sample in a million-sample run are irrelevant.
+    let abs_tol = 1e-9 / (cols * rows) as f64;
+    let mut grid = Grid::new(cols, rows);
+    for r in 0..rows {
+        for c in 0..cols {
+            let u = [u0 + c as f64 * du, u0 + (c + 1) as f64 * du];
+            let v = [v0 + r as f64 * dv, v0 + (r + 1) as f64 * dv];
+            grid.data[r * cols + c] = integrate_rect(&mut f, u, v, cfg, abs_tol);
+        }
+    }
+    (grid, bad)
+}
+
+/// Outcome of the Pearson statistic over (observed, expected) categories.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pearson {
+    pub statistic: f64,
+    /// Categories used after pooling, minus one.
+    pub dof: usize,
+}
+
+/// Pearson statistic with Nori's pooling: categories sorted by expected count; those below
+/// `min_expected` are pooled; while the pool is still below `min_expected` the next
+/// larger category joins it. Categories with expected count 0 must have been removed (their
+/// observed counts are the caller's failure criterion).
+pub fn pearson(cells: &mut [(f64, f64)], min_expected: f64) -> Option<Pearson> {
+    cells.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let (mut pool_obs, mut pool_exp) = (0.0, 0.0);
+    let (mut stat, mut used) = (0.0, 0usize);
+    for &(obs, exp) in cells.iter() {
+        if exp < min_expected || (pool_exp > 0.0 && pool_exp < min_expected) {
+            pool_obs += obs;
+            pool_exp += exp;
+        } else {
+            stat += (obs - exp) * (obs - exp) / exp;
+            used += 1;
+        }
+    }
+    if pool_exp > 0.0 {
+        stat += (pool_obs - pool_exp) * (pool_obs - pool_exp) / pool_exp;
+        used += 1;
+    }
+    (used >= 2).then_some(Pearson {
+        statistic: stat,
+        dof: used - 1,
+    })
+}
+
+/// Upper tail of the chi-square distribution: the test's p-value.
+pub fn chi2_sf(statistic: f64, dof: usize) -> f64 {
+    ChiSquared::new(dof as f64)
+        .expect("positive degrees of freedom")
+        .sf(statistic)
+}
+
+/// Runs the sampler `cfg.samples` times and tests its histogram against `pdf`.
+pub fn chi2_test<D: Domain>(
+    domain: &D,
+    mut sampler: impl FnMut(&mut Rng) -> Option<D::Point>,
+    pdf: impl Fn(D::Point) -> f64,
+    cfg: &Chi2Config,
+) -> Chi2Result {
+    let (cols, rows) = domain.resolution();
+    let n = cfg.samples;
+    let nf = n as f64;
+    let mut observed = Grid::new(cols, rows);
+    let (mut lost, mut outside) = (0u64, 0u64);
+    let mut first_outside = None;
+    let mut rng = Rng::new(cfg.seed, 0);
+    for _ in 0..n {
+        match sampler(&mut rng).map(|p| domain.cell_of(p)) {
+            None => lost += 1,
+            Some(Ok((c, r))) => observed.data[r * cols + c] += 1.0,
+            Some(Err(why)) => {
+                outside += 1;
+                first_outside.get_or_insert(why);
+            }
+        }
+    }
+
+    let (fractions, bad_pdf) = cell_integrals(domain, &pdf, &cfg.integration);
+    let pdf_integral = fractions.sum();
+    let expected = Grid {
+        data: fractions.data.iter().map(|x| x * nf).collect(),
+        ..fractions
+    };
+
+    let mut result = Chi2Result {
+        domain: domain.name(),
+        statistic: f64::NAN,
+        dof: 0,
+        p_value: 0.0,
+        threshold: cfg.threshold,
+        verdict: Verdict::Fail,
+        reason: String::new(),
+        observed,
+        expected,
+        samples: n,
+        lost,
+        outside,
+        pdf_integral,
+    };
+    let fail = |mut r: Chi2Result, reason: String| {
+        r.reason = reason;
+        r
+    };
+
+    if let Some(why) = first_outside {
+        return fail(
+            result,
+            format!(
+                "{outside} of {n} samples outside the {} (first: {why})",
+                domain.name()
+            ),
+        );
+    }
+    if bad_pdf > 0 {
+        return fail(
+            result,
+            format!("pdf returned NaN or a negative value at {bad_pdf} integration nodes"),
+        );
+    }
+
+    // Categories: every cell, plus "lost" when the sampler failed at all.
+    let zero = 1e-12 * nf;
+    let tolerated = cfg.zero_tolerance * nf;
+    let mut cells: Vec<(f64, f64)> = Vec::with_capacity(cols * rows + 1);
+    for (i, (&obs, &exp)) in result
+        .observed
+        .data
+        .iter()
+        .zip(&result.expected.data)
+        .enumerate()
+    {
+        if exp > zero {
+            cells.push((obs, exp));
+        } else if obs > tolerated {
+            let (c, r) = (i % cols, i / cols);
+            return fail(
+                result,
+                format!(
+                    "{obs} samples in cell (col {c}, row {r}) where the pdf integrates to 0 \
+                     (tolerance {tolerated:.1}): the sampler produces points its pdf says are impossible"
+                ),
+            );
+        }
+    }
+    if lost > 0 {
+        let exp_lost = (nf * (1.0 - pdf_integral)).max(0.0);
+        if exp_lost <= zero && lost as f64 > tolerated {
+            return fail(
+                result,
+                format!(
+                    "sampler failed (returned None) {lost} times of {n}, but the pdf integrates \
+                     to {pdf_integral:.6}, leaving no probability for failure"
+                ),
+            );
+        }
+        if exp_lost > zero {
+            cells.push((lost as f64, exp_lost));
+        }
+    }
+
+    let Some(p) = pearson(&mut cells, cfg.min_expected) else {
+        return fail(
+            result,
+            "fewer than two usable cells; raise the sample count".into(),
+        );
+    };
+    result.statistic = p.statistic;
+    result.dof = p.dof;
+    result.p_value = chi2_sf(p.statistic, p.dof);
+    let summary = format!(
+        "chi2 = {:.2}, dof = {}, p = {:.4e} vs threshold {:.4e}; pdf integral {:.6}, lost {}",
+        p.statistic, p.dof, result.p_value, cfg.threshold, pdf_integral, lost
+    );
+    if result.p_value >= cfg.threshold {
+        result.verdict = Verdict::Pass;
+        result.reason = summary;
+    } else {
+        result.reason = format!("rejected: sample histogram does not match the pdf ({summary})");
+    }
+    result
+}
+
+#[cfg(test)]
+#[path = "chi2_tests.rs"]
+mod tests;

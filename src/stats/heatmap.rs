@@ -1,0 +1,163 @@
+//! PNG of a chi-square run: observed | expected | standardised residual, side by side.
+//!
+//! Observed and expected share one colour scale so a mismatch shows as a visible difference;
+//! the residual (obs - exp) / sqrt(exp) is roughly N(0, 1) per cell under the null, so a
+//! fixed diverging scale clamped at +-5 makes real structure (a ring, a seam) stand out
+//! against noise. The v parameter (cos theta, y, r^2) increases upwards.
+
+use super::chi2::{Chi2Result, Grid};
+use image::{ImageError, ImageFormat, Rgb, RgbImage};
+use std::path::{Path, PathBuf};
+
+/// Pixels between panels.
+const GAP: u32 = 4;
+const BACKGROUND: Rgb<u8> = Rgb([40, 40, 40]);
+/// Cells the pdf gives no mass and no sample reached (outside the support).
+const EMPTY: Rgb<u8> = Rgb([128, 128, 128]);
+/// Residuals are clamped here.
+pub const RESIDUAL_CLAMP: f64 = 5.0;
+
+fn lerp_rgb(stops: &[[f64; 3]], t: f64) -> Rgb<u8> {
+    let t = t.clamp(0.0, 1.0) * (stops.len() - 1) as f64;
+    let i = (t.floor() as usize).min(stops.len() - 2);
+    let f = t - i as f64;
+    let c = |k: usize| (255.0 * (stops[i][k] * (1.0 - f) + stops[i + 1][k] * f)).round() as u8;
+    Rgb([c(0), c(1), c(2)])
+}
+
+/// Perceptually ordered dark-to-bright ramp (a coarse viridis).
+fn sequential(t: f64) -> Rgb<u8> {
+    const STOPS: [[f64; 3]; 5] = [
+        [0.267, 0.005, 0.329],
+        [0.230, 0.322, 0.546],
+        [0.128, 0.567, 0.551],
+        [0.369, 0.789, 0.383],
+        [0.993, 0.906, 0.144],
+    ];
+    lerp_rgb(&STOPS, t)
+}
+
+/// Blue (negative) - white (0) - red (positive) for t in [-1, 1].
+fn diverging(t: f64) -> Rgb<u8> {
+    const STOPS: [[f64; 3]; 3] = [[0.10, 0.25, 0.85], [1.0, 1.0, 1.0], [0.85, 0.10, 0.10]];
+    lerp_rgb(&STOPS, 0.5 * (t + 1.0))
+}
+
+/// Standardised residual of one cell, clamped; None where the cell is empty and impossible.
+fn residual(obs: f64, exp: f64) -> Option<f64> {
+    if exp > 0.0 {
+        Some(((obs - exp) / exp.sqrt()).clamp(-RESIDUAL_CLAMP, RESIDUAL_CLAMP))
+    } else if obs > 0.0 {
+        Some(RESIDUAL_CLAMP)
+    } else {
+        None
+    }
+}
+
+/// Draws the three panels, each cell `cell_px` pixels square.
+pub fn render(observed: &Grid, expected: &Grid, cell_px: u32) -> RgbImage {
+    assert_eq!(
+        (observed.cols, observed.rows),
+        (expected.cols, expected.rows)
+    );
+    let (cols, rows) = (observed.cols as u32, observed.rows as u32);
+    let s = cell_px.max(1);
+    let (pw, ph) = (cols * s, rows * s);
+    let mut img = RgbImage::from_pixel(3 * pw + 2 * GAP, ph, BACKGROUND);
+    let peak = observed
+        .data
+        .iter()
+        .chain(&expected.data)
+        .fold(0.0f64, |m, &x| m.max(x));
+    let scale = if peak > 0.0 { 1.0 / peak } else { 0.0 };
+    for r in 0..rows {
+        for c in 0..cols {
+            let (obs, exp) = (
+                observed.get(c as usize, r as usize),
+                expected.get(c as usize, r as usize),
+            );
+            let colours = [
+                sequential(obs * scale),
+                sequential(exp * scale),
+                residual(obs, exp).map_or(EMPTY, |z| diverging(z / RESIDUAL_CLAMP)),
+            ];
+            // Row 0 is v = v0, drawn at the bottom.
+            let y0 = (rows - 1 - r) * s;
+            for (panel, colour) in colours.into_iter().enumerate() {
+                let x0 = panel as u32 * (pw + GAP) + c * s;
+                for y in y0..y0 + s {
+                    for x in x0..x0 + s {
+                        img.put_pixel(x, y, colour);
+                    }
+                }
+            }
+        }
+    }
+    img
+}
+
+/// Writes [`render`] of a run to `path` as PNG, via `path.tmp` and a rename so readers never
+/// see a half-written file.
+pub fn write(path: &Path, result: &Chi2Result, cell_px: u32) -> Result<(), ImageError> {
+    let img = render(&result.observed, &result.expected, cell_px);
+    let mut tmp = PathBuf::from(path).into_os_string();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    img.save_with_format(&tmp, ImageFormat::Png)?;
+    std::fs::rename(&tmp, path).map_err(ImageError::IoError)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stats::chi2::{chi2_test, Chi2Config};
+    use crate::stats::domain::Sphere;
+    use glam::Vec3;
+
+    #[test]
+    fn writes_png_of_expected_size() {
+        // Deliberately wrong pair (uniform sphere sampler, cosine pdf) so the residual panel
+        // has structure. N = 20k; the verdict is irrelevant here.
+        let domain = Sphere {
+            n_phi: 11,
+            n_cos: 21,
+        };
+        let cfg = Chi2Config {
+            samples: 20_000,
+            ..Chi2Config::default()
+        };
+        let sampler = |g: &mut crate::rng::Rng| {
+            let z = 2.0 * g.next_f32() - 1.0;
+            let phi = std::f32::consts::TAU * g.next_f32();
+            let s = (1.0 - z * z).max(0.0).sqrt();
+            Some(Vec3::new(s * phi.cos(), s * phi.sin(), z))
+        };
+        let r = chi2_test(
+            &domain,
+            sampler,
+            |d| d.z.max(0.0) as f64 / std::f64::consts::PI,
+            &cfg,
+        );
+        let dir = std::env::temp_dir().join(format!("directlab-heatmap-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("chi2.png");
+        write(&path, &r, 6).unwrap();
+        let img = image::open(&path).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (3 * 11 * 6 + 2 * GAP, 21 * 6));
+        assert!(!dir.join("chi2.png.tmp").exists());
+        // Lower hemisphere: samples where the pdf is 0 are drawn saturated red.
+        assert_eq!(
+            *img.get_pixel(2 * (66 + GAP) + 3, 21 * 6 - 3),
+            diverging(1.0)
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn colour_maps_hit_their_ends() {
+        assert_eq!(diverging(0.0), Rgb([255, 255, 255]));
+        assert_eq!(diverging(-1.0), Rgb([26, 64, 217]));
+        assert_eq!(residual(0.0, 0.0), None);
+        assert_eq!(residual(100.0, 4.0), Some(RESIDUAL_CLAMP));
+    }
+}
