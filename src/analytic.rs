@@ -126,6 +126,54 @@ pub fn sphere_cap_solid_angle(p: DVec3, center: DVec3, radius: f64) -> f64 {
     TAU * sin2 / (1.0 + cos)
 }
 
+/// Nori's triangle-light tests (wjakob/nori, scenes/pa4/tests/test-mesh.xml, emitters
+/// polylum1..5.obj; generator scenes/pa4/tests/meshes/polylum.py). Receiver: the floor
+/// y = 0 (albedo 0.5) at the origin, normal +y, seen by a 1x1-pixel camera looking down from
+/// (0, 0.01, 0). Each emitter is one triangle of unit radiance in y > 0, wound so that its
+/// right-hand normal faces the origin. Reference: outgoing radiance of the floor.
+pub const NORI_TRIANGLE_TESTS: [([[f64; 3]; 3], f64); 5] = [
+    (
+        [
+            [-0.443432, 0.596366, 0.495985],
+            [-0.320397, 0.0677699, -0.229359],
+            [0.0341197, 0.11415, -0.343049],
+        ],
+        0.0898394,
+    ),
+    (
+        [
+            [0.461963, 0.397843, 0.412747],
+            [-0.0381582, 0.851323, -0.156872],
+            [0.195443, 0.891957, -0.260672],
+        ],
+        0.02292,
+    ),
+    (
+        [
+            [0.100871, 0.289075, -0.422609],
+            [-0.308386, 0.629587, 0.423966],
+            [-0.373132, 0.237287, 0.351592],
+        ],
+        0.0534198,
+    ),
+    (
+        [
+            [-0.17575, 0.639397, 0.151268],
+            [0.318604, 0.732996, 0.459771],
+            [0.139095, 0.294498, 0.478556],
+        ],
+        0.0205314,
+    ),
+    (
+        [
+            [-0.17487, 0.447916, 0.367201],
+            [-0.405259, 0.249607, -0.354079],
+            [0.356029, 0.0918984, -0.132271],
+        ],
+        0.26174,
+    ),
+];
+
 #[cfg(test)]
 #[path = "analytic_tests.rs"]
 mod tests;

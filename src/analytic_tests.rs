@@ -4,54 +4,6 @@ use super::*;
 use crate::rng::Rng;
 use glam::dvec3;
 
-/// Nori's triangle-light tests (wjakob/nori, scenes/pa4/tests/test-mesh.xml, emitters
-/// polylum1..5.obj; generator scenes/pa4/tests/meshes/polylum.py). Receiver: the floor
-/// y = 0 (albedo 0.5) at the origin, normal +y, seen by a 1x1-pixel camera looking down from
-/// (0, 0.01, 0). Each emitter is one triangle of unit radiance in y > 0, wound so that its
-/// right-hand normal faces the origin. Reference: outgoing radiance of the floor.
-const NORI: [([[f64; 3]; 3], f64); 5] = [
-    (
-        [
-            [-0.443432, 0.596366, 0.495985],
-            [-0.320397, 0.0677699, -0.229359],
-            [0.0341197, 0.11415, -0.343049],
-        ],
-        0.0898394,
-    ),
-    (
-        [
-            [0.461963, 0.397843, 0.412747],
-            [-0.0381582, 0.851323, -0.156872],
-            [0.195443, 0.891957, -0.260672],
-        ],
-        0.02292,
-    ),
-    (
-        [
-            [0.100871, 0.289075, -0.422609],
-            [-0.308386, 0.629587, 0.423966],
-            [-0.373132, 0.237287, 0.351592],
-        ],
-        0.0534198,
-    ),
-    (
-        [
-            [-0.17575, 0.639397, 0.151268],
-            [0.318604, 0.732996, 0.459771],
-            [0.139095, 0.294498, 0.478556],
-        ],
-        0.0205314,
-    ),
-    (
-        [
-            [-0.17487, 0.447916, 0.367201],
-            [-0.405259, 0.249607, -0.354079],
-            [0.356029, 0.0918984, -0.132271],
-        ],
-        0.26174,
-    ),
-];
-
 fn verts(t: &[[f64; 3]]) -> Vec<DVec3> {
     t.iter().map(|v| DVec3::from_array(*v)).collect()
 }
@@ -60,7 +12,7 @@ fn verts(t: &[[f64; 3]]) -> Vec<DVec3> {
 fn matches_nori_references() {
     // Nori's obj files print vertices to 6 significant digits, its references to 6 too:
     // agreement to 1e-5 relative is all the inputs allow.
-    for (i, (tri, reference)) in NORI.into_iter().enumerate() {
+    for (i, (tri, reference)) in NORI_TRIANGLE_TESTS.into_iter().enumerate() {
         let e = polygon_irradiance(DVec3::ZERO, DVec3::Y, &verts(&tri), 1.0).unwrap();
         let lo = diffuse_radiance(0.5, e);
         eprintln!(
@@ -301,9 +253,9 @@ fn monte_carlo_estimates_pass_t_test_against_lambert() {
     // Nori-style t-test: 100k samples per triangle, two-sided, alpha = 0.01 Sidak-corrected
     // over the 5 triangles. The same estimator without the light's cosine must fail.
     use crate::stats::{one_sample_welford, sidak, Welford};
-    let alpha = sidak(0.01, NORI.len());
+    let alpha = sidak(0.01, NORI_TRIANGLE_TESTS.len());
     let mut rng = Rng::new(2024, 3);
-    for (i, (tri, _)) in NORI.iter().enumerate() {
+    for (i, (tri, _)) in NORI_TRIANGLE_TESTS.iter().enumerate() {
         let tri = verts(tri);
         let exact = polygon_irradiance(DVec3::ZERO, DVec3::Y, &tri, 1.0).unwrap();
         let good: Welford = (0..100_000)
