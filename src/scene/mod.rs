@@ -2,6 +2,8 @@
 
 pub mod desc;
 pub mod error;
+pub mod mesh;
+pub mod transform;
 pub mod xml;
 
 pub use error::SceneError;
