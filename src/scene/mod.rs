@@ -3,6 +3,7 @@
 pub mod desc;
 pub mod error;
 pub mod mesh;
+pub mod props;
 pub mod transform;
 pub mod xml;
 
