@@ -103,11 +103,10 @@ pub fn load_obj(path: &Path) -> Result<TriMesh, String> {
         single_index: true,
         ..Default::default()
     };
-    let (models, _materials) =
-        tobj::load_obj_buf(&mut BufReader::new(file), &opts, |_| {
-            Err(tobj::LoadError::OpenFileFailed)
-        })
-        .map_err(|e| format!("cannot read mesh file '{}': {e}", path.display()))?;
+    let (models, _materials) = tobj::load_obj_buf(&mut BufReader::new(file), &opts, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| format!("cannot read mesh file '{}': {e}", path.display()))?;
 
     let mut out = TriMesh {
         positions: Vec::new(),
@@ -119,7 +118,7 @@ pub fn load_obj(path: &Path) -> Result<TriMesh, String> {
         let base = out.positions.len() as u32;
         let nverts = m.positions.len() / 3;
         for (i, p) in m.positions.chunks_exact(3).enumerate() {
-            let v = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+            let v = Vec3::from_slice(p);
             if !v.is_finite() {
                 return Err(format!(
                     "mesh file '{}': vertex {} of object '{}' is not finite: {v}",
@@ -134,7 +133,7 @@ pub fn load_obj(path: &Path) -> Result<TriMesh, String> {
         if m.normals.len() == m.positions.len() && nverts > 0 {
             if let Some(normals) = &mut out.normals {
                 for (i, n) in m.normals.chunks_exact(3).enumerate() {
-                    let n = Vec3::new(n[0] as f32, n[1] as f32, n[2] as f32);
+                    let n = Vec3::from_slice(n);
                     if !n.is_finite() {
                         return Err(format!(
                             "mesh file '{}': normal of vertex {} of object '{}' is not finite: {n}",
@@ -208,7 +207,10 @@ mod tests {
         };
         m.transform(&Mat4::from_scale(Vec3::new(2.0, 1.0, 1.0)));
         let n = m.normals.unwrap()[0];
-        assert!(n.abs_diff_eq(Vec3::new(1.0, 2.0, 0.0).normalize(), 1e-6), "{n}");
+        assert!(
+            n.abs_diff_eq(Vec3::new(1.0, 2.0, 0.0).normalize(), 1e-6),
+            "{n}"
+        );
     }
 
     #[test]

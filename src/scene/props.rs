@@ -141,9 +141,10 @@ impl<'a> Plugin<'a> {
             return Err(Self::wrong_type(p, "an <integer>"));
         }
         let v = parse_int(Self::value(p)?).map_err(|m| p.elem.err(m))?;
-        u32::try_from(v)
-            .map(Some)
-            .map_err(|_| p.elem.err(format!("expected a non-negative integer, found {v}")))
+        u32::try_from(v).map(Some).map_err(|_| {
+            p.elem
+                .err(format!("expected a non-negative integer, found {v}"))
+        })
     }
 
     pub fn boolean(&self, key: &'static str) -> Result<Option<bool>, SceneError> {
@@ -201,7 +202,12 @@ impl<'a> Plugin<'a> {
                 [parse_float(v).map_err(|m| e.err(m))?; 3]
             }
             "float" | "integer" => [parse_float(Self::value(p)?).map_err(|m| e.err(m))?; 3],
-            _ => return Err(Self::wrong_type(p, "a colour (<rgb>, <spectrum> or <float>)")),
+            _ => {
+                return Err(Self::wrong_type(
+                    p,
+                    "a colour (<rgb>, <spectrum> or <float>)",
+                ))
+            }
         };
         Ok(Some(Vec3::from(rgb)))
     }
@@ -262,11 +268,9 @@ impl<'a> Plugin<'a> {
         match self.nested(tags).as_slice() {
             [] => Ok(None),
             [one] => Ok(Some(*one)),
-            [_, second, ..] => Err(second.err(format!(
-                "{} takes only one <{}>",
-                self.what(),
-                tags[0]
-            ))),
+            [_, second, ..] => {
+                Err(second.err(format!("{} takes only one <{}>", self.what(), tags[0])))
+            }
         }
     }
 
@@ -343,9 +347,15 @@ mod tests {
         assert_eq!(p.vec3("pos").unwrap(), Some(Vec3::new(1.0, 0.0, 3.0)));
         assert_eq!(p.float("missing").unwrap(), None);
         let e = p.finish().unwrap_err().to_string();
-        assert!(e.starts_with("p.xml:6: <string name=\"typo\" value=\"1\">"), "{e}");
+        assert!(
+            e.starts_with("p.xml:6: <string name=\"typo\" value=\"1\">"),
+            "{e}"
+        );
         assert!(e.contains("unknown parameter 'typo' for bsdf 'x'"), "{e}");
-        assert!(e.contains("expected one of: alpha, flip, kd, missing, pos"), "{e}");
+        assert!(
+            e.contains("expected one of: alpha, flip, kd, missing, pos"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -356,7 +366,10 @@ mod tests {
         assert!(e.contains("expects a <float>"), "{e}");
 
         let r = root(r#"<float name="a" value="1"/><float name="a" value="2"/>"#);
-        let e = Plugin::new(&r.children[0], &["type"]).err().unwrap().to_string();
+        let e = Plugin::new(&r.children[0], &["type"])
+            .err()
+            .unwrap()
+            .to_string();
         assert!(e.contains("given twice"), "{e}");
 
         let r = root(r#"<rgb name="c" value="1, nan, 0"/>"#);
@@ -365,7 +378,10 @@ mod tests {
         assert!(e.contains("p.xml:3: <rgb") && e.contains("finite"), "{e}");
 
         let r = root(r#"<texture type="bitmap" name="reflectance"/>"#);
-        let e = Plugin::new(&r.children[0], &["type"]).err().unwrap().to_string();
+        let e = Plugin::new(&r.children[0], &["type"])
+            .err()
+            .unwrap()
+            .to_string();
         assert!(e.contains("texture 'bitmap' is not supported yet"), "{e}");
     }
 

@@ -41,10 +41,7 @@ fn parse_op(op: &Element) -> Result<Mat4, SceneError> {
             let angle = op
                 .float_attr("angle")?
                 .ok_or_else(|| op.err("expected an 'angle' attribute (degrees)"))?;
-            Ok(Mat4::from_axis_angle(
-                axis.normalize(),
-                angle.to_radians(),
-            ))
+            Ok(Mat4::from_axis_angle(axis.normalize(), angle.to_radians()))
         }
         "lookat" | "look_at" => {
             op.check_attrs(&["origin", "target", "up"])?;
@@ -153,22 +150,30 @@ mod tests {
     fn matrix_is_row_major() {
         let m = transform(r#"<matrix value="1 0 0 5  0 1 0 6  0 0 1 7  0 0 0 1"/>"#).unwrap();
         assert!(close(m, Mat4::from_translation(Vec3::new(5.0, 6.0, 7.0))));
-        let e = transform(r#"<matrix value="1 2 3"/>"#).unwrap_err().to_string();
+        let e = transform(r#"<matrix value="1 2 3"/>"#)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("expected 16"), "{e}");
         let e = transform(r#"<matrix value="1 0 0 nan 0 1 0 0 0 0 1 0 0 0 0 1"/>"#)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("t.xml:1: <matrix") && e.contains("finite"), "{e}");
+        assert!(
+            e.contains("t.xml:1: <matrix") && e.contains("finite"),
+            "{e}"
+        );
     }
 
     #[test]
     fn lookat_frame() {
-        let m = transform(r#"<lookat origin="278, 273, -800" target="278, 273, -799" up="0, 1, 0"/>"#)
-            .unwrap();
+        let m =
+            transform(r#"<lookat origin="278, 273, -800" target="278, 273, -799" up="0, 1, 0"/>"#)
+                .unwrap();
         assert!(m.col(0).truncate().abs_diff_eq(Vec3::X, 1e-6)); // left
         assert!(m.col(1).truncate().abs_diff_eq(Vec3::Y, 1e-6));
         assert!(m.col(2).truncate().abs_diff_eq(Vec3::Z, 1e-6));
-        assert!(m.col(3).abs_diff_eq(glam::Vec4::new(278.0, 273.0, -800.0, 1.0), 1e-4));
+        assert!(m
+            .col(3)
+            .abs_diff_eq(glam::Vec4::new(278.0, 273.0, -800.0, 1.0), 1e-4));
         // looking down -z: left is -x
         let m = transform(r#"<lookat origin="0,0,0" target="0,0,-1" up="0,1,0"/>"#).unwrap();
         assert!(m.col(0).truncate().abs_diff_eq(-Vec3::X, 1e-6));
@@ -181,10 +186,15 @@ mod tests {
     #[test]
     fn bad_ops_are_errors() {
         let e = transform(r#"<shear value="1"/>"#).unwrap_err().to_string();
-        assert!(e.contains("<shear") && e.contains("unknown transform"), "{e}");
+        assert!(
+            e.contains("<shear") && e.contains("unknown transform"),
+            "{e}"
+        );
         let e = transform(r#"<rotate y="1"/>"#).unwrap_err().to_string();
         assert!(e.contains("angle"), "{e}");
-        let e = transform(r#"<translate x="abc"/>"#).unwrap_err().to_string();
+        let e = transform(r#"<translate x="abc"/>"#)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("expected a number, found \"abc\""), "{e}");
         let e = transform(r#"<translate q="1"/>"#).unwrap_err().to_string();
         assert!(e.contains("unexpected attribute 'q'"), "{e}");

@@ -40,7 +40,7 @@ impl Element {
 
     /// "file:line <tag ...>", the form used in warnings and `ShapeDesc::origin`.
     pub fn origin(&self) -> String {
-        format!("{}:{}: {}", self.file.display(), self.line, self.display)
+        format!("{}:{} {}", self.file.display(), self.line, self.display)
     }
 
     pub fn required_attr(&self, name: &str) -> Result<&str, SceneError> {
@@ -260,7 +260,9 @@ mod tests {
     #[test]
     fn numbers() {
         assert_eq!(parse_float(" 1.5 "), Ok(1.5));
-        assert!(parse_float("abc").unwrap_err().contains("expected a number"));
+        assert!(parse_float("abc")
+            .unwrap_err()
+            .contains("expected a number"));
         assert!(parse_float("nan").unwrap_err().contains("finite"));
         assert!(parse_float("inf").unwrap_err().contains("finite"));
         assert_eq!(parse_floats("1, 2 3,4"), Ok(vec![1.0, 2.0, 3.0, 4.0]));
@@ -302,7 +304,10 @@ mod tests {
     fn undefined_parameter_is_reported_with_position() {
         let xml = "<scene version=\"3.0.0\">\n  <float name=\"fov\" value=\"$fov\"/>\n</scene>";
         let e = parse(xml, &[]).unwrap_err().to_string();
-        assert!(e.starts_with("t.xml:2: <float name=\"fov\" value=\"$fov\">"), "{e}");
+        assert!(
+            e.starts_with("t.xml:2: <float name=\"fov\" value=\"$fov\">"),
+            "{e}"
+        );
         assert!(e.contains("'$fov' is not defined"), "{e}");
     }
 
@@ -317,7 +322,11 @@ mod tests {
 
     #[test]
     fn elements_remember_lines_and_attributes() {
-        let root = parse("<scene>\n\n  <bsdf type=\"diffuse\" id=\"a\"/>\n</scene>", &[]).unwrap();
+        let root = parse(
+            "<scene>\n\n  <bsdf type=\"diffuse\" id=\"a\"/>\n</scene>",
+            &[],
+        )
+        .unwrap();
         let b = &root.children[0];
         assert_eq!(b.line, 3);
         assert_eq!(b.display, "<bsdf type=\"diffuse\" id=\"a\">");
