@@ -11,3 +11,6 @@ pub mod xml;
 
 pub use error::SceneError;
 pub use loader::{load_scene, load_scene_str, Dialect};
+
+#[cfg(test)]
+mod bundled_tests;
