@@ -78,93 +78,31 @@ pub(super) struct Loader<'a> {
 
 /// Plugin types that exist in Mitsuba or Nori but that directlab does not implement; naming
 /// them gives a "not supported yet" instead of an "unknown type" message.
+#[rustfmt::skip]
 const KNOWN_SHAPES: &[&str] = &[
-    "ply",
-    "serialized",
-    "disk",
-    "cylinder",
-    "shapegroup",
-    "instance",
-    "hair",
-    "heightfield",
-    "bsplinecurve",
-    "linearcurve",
-    "sdfgrid",
-    "ellipsoids",
-    "ellipsoidsmesh",
-    "merge",
+    "ply", "serialized", "disk", "cylinder", "shapegroup", "instance", "hair", "heightfield",
+    "bsplinecurve", "linearcurve", "sdfgrid", "ellipsoids", "ellipsoidsmesh", "merge",
 ];
+#[rustfmt::skip]
 const KNOWN_EMITTERS: &[&str] = &[
-    "envmap",
-    "constant",
-    "directional",
-    "spot",
-    "projector",
-    "sunsky",
-    "sky",
-    "sun",
-    "collimated",
-    "directionalarea",
-    "environment",
-    "envlight",
+    "envmap", "constant", "directional", "spot", "projector", "sunsky", "sky", "sun",
+    "collimated", "directionalarea", "environment", "envlight",
 ];
+#[rustfmt::skip]
 const KNOWN_INTEGRATORS: &[&str] = &[
-    "path",
-    "volpath",
-    "volpathmis",
-    "prb",
-    "prb_basic",
-    "prbvolpath",
-    "direct_projective",
-    "prb_projective",
-    "aov",
-    "moment",
-    "stokes",
-    "ptracer",
-    "depth",
-    "bdpt",
-    "mlt",
-    "pssmlt",
-    "erpt",
-    "photonmapper",
-    "ppm",
-    "sppm",
-    "vpl",
-    "ao",
-    "normals",
-    "av",
-    "whitted",
-    "path_mis",
-    "path_mats",
-    "path_ems",
-    "simple",
-    "volpath_simple",
-    "irrcache",
-    "adaptive",
-    "field",
+    "path", "volpath", "volpathmis", "prb", "prb_basic", "prbvolpath", "direct_projective",
+    "prb_projective", "aov", "moment", "stokes", "ptracer", "depth", "bdpt", "mlt", "pssmlt",
+    "erpt", "photonmapper", "ppm", "sppm", "vpl", "ao", "normals", "av", "whitted", "path_mis",
+    "path_mats", "path_ems", "simple", "volpath_simple", "irrcache", "adaptive", "field",
 ];
+#[rustfmt::skip]
 const KNOWN_SENSORS: &[&str] = &[
-    "orthographic",
-    "thinlens",
-    "radiancemeter",
-    "irradiancemeter",
-    "distant",
-    "batch",
-    "fluencemeter",
-    "spherical",
-    "telecentric",
-    "environment",
-    "perspective_rdist",
+    "orthographic", "thinlens", "radiancemeter", "irradiancemeter", "distant", "batch",
+    "fluencemeter", "spherical", "telecentric", "environment", "perspective_rdist",
 ];
+#[rustfmt::skip]
 const KNOWN_SAMPLERS: &[&str] = &[
-    "stratified",
-    "multijitter",
-    "orthogonal",
-    "ldsampler",
-    "halton",
-    "hammersley",
-    "sobol",
-    "ldsampler",
+    "stratified", "multijitter", "orthogonal", "ldsampler", "halton", "hammersley", "sobol",
     "low_discrepancy",
 ];
 
@@ -429,8 +367,12 @@ impl<'a> Loader<'a> {
             )));
         }
         let to_world = p.transform("to_world")?.unwrap_or(Mat4::IDENTITY);
-        if to_world.determinant().abs() < 1e-12 {
-            return Err(e.err("the sensor's to_world is singular"));
+        // Rays are built from this matrix; a scale would silently change their lengths (Mitsuba
+        // rejects it too). Mirroring, as in Nori's `<scale value="-1,1,1"/>`, is fine.
+        if !similarity_scale(&to_world).is_some_and(|s| (s - 1.0).abs() < 1e-3) {
+            return Err(e.err(
+                "the sensor's to_world may only rotate, translate and mirror (no scale or shear)",
+            ));
         }
         p.ignore("shutter_open", "no motion blur", &mut self.warnings);
         p.ignore("shutter_close", "no motion blur", &mut self.warnings);
@@ -486,9 +428,14 @@ impl<'a> Loader<'a> {
         let p = Plugin::new(e, &["type", "id", "name"])?;
         match p.ty.as_str() {
             "hdrfilm" => {}
-            t @ ("ldrfilm" | "specfilm" | "mfilm" | "tiledhdrfilm") => {
-                return Err(unsupported(e, "film", t))
+            // Only the output encoding differs, and directlab always writes HDR.
+            "ldrfilm" => {
+                self.warn(e, "ldrfilm treated as hdrfilm: tone mapping is not applied");
+                for key in ["tonemap_method", "gamma", "exposure", "key", "burn"] {
+                    p.ignore(key, "tone mapping (ldrfilm)", &mut self.warnings);
+                }
             }
+            t @ ("specfilm" | "mfilm" | "tiledhdrfilm") => return Err(unsupported(e, "film", t)),
             t => return Err(unknown(e, "film", t, "hdrfilm")),
         }
         let d = self.default_film();
@@ -623,8 +570,17 @@ impl<'a> Loader<'a> {
                     _ => mesh::cube(),
                 };
                 let face_normals = p.boolean("face_normals")?.unwrap_or(false);
-                if to_world.determinant().abs() < 1e-30 {
+                let det = to_world.determinant();
+                if det.abs() < 1e-30 {
                     return Err(e.err("to_world is singular (zero scale?)"));
+                }
+                if det < 0.0 {
+                    self.warn(
+                        e,
+                        "to_world mirrors the shape; triangles keep their vertex order, so the \
+                         winding-based normal flips relative to the (transformed) vertex \
+                         normals; add flip_normals if the wrong side faces out",
+                    );
                 }
                 mesh.transform(&to_world);
                 if face_normals {

@@ -853,3 +853,40 @@ fn no_sensor_and_malformed_xml() {
     let e = load("<scene version=\"1.0\"/>").unwrap_err().to_string();
     assert!(e.contains("unsupported scene version"), "{e}");
 }
+
+#[test]
+fn camera_may_mirror_but_not_scale() {
+    let cam = |t: &str| {
+        format!(
+            "<scene version=\"3.0.0\">{LIGHT}\n<sensor type=\"perspective\"><float name=\"fov\" value=\"45\"/>\
+             <transform name=\"to_world\">{t}</transform></sensor></scene>"
+        )
+    };
+    assert!(load(&cam(
+        r#"<scale value="-1,1,1"/><rotate y="1" angle="30"/><translate x="4"/>"#
+    ))
+    .is_ok());
+    let e = load(&cam(r#"<scale value="2"/>"#)).unwrap_err().to_string();
+    assert!(
+        e.starts_with("dir/test.xml:2: <sensor type=\"perspective\">") && e.contains("no scale"),
+        "{e}"
+    );
+}
+
+#[test]
+fn mirrored_mesh_warns_and_ldrfilm_is_accepted() {
+    let s = m3(
+        r#"<shape type="rectangle"><transform name="to_world"><scale x="-1"/></transform></shape>"#,
+    );
+    assert!(
+        s.warnings.iter().any(|w| w.contains("mirrors the shape")),
+        "{:?}",
+        s.warnings
+    );
+    let xml = r#"<scene version="0.6.0"><sensor type="perspective"><float name="fov" value="45"/>
+        <film type="ldrfilm"><float name="gamma" value="2.2"/><integer name="width" value="8"/></film>
+        </sensor><emitter type="point"/></scene>"#;
+    let s = load(xml).unwrap();
+    assert_eq!(s.film.width, 8);
+    assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
+}
