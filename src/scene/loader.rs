@@ -309,7 +309,7 @@ impl<'a> Loader<'a> {
             &mut self.warnings,
         );
         p.finish()?;
-        if emitter_samples + bsdf_samples == 0 {
+        if emitter_samples == 0 && bsdf_samples == 0 {
             return Err(e.err("emitter_samples and bsdf_samples are both 0"));
         }
         Ok(IntegratorDesc {
@@ -559,6 +559,7 @@ impl<'a> Loader<'a> {
                             .string("filename")?
                             .ok_or_else(|| e.err("expected a 'filename' parameter"))?;
                         let path = self.base_dir.join(&file);
+                        p.reject("max_smooth_angle")?;
                         p.ignore(
                             "flip_tex_coords",
                             "meshes carry no texture coordinates",

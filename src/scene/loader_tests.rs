@@ -890,3 +890,13 @@ fn mirrored_mesh_warns_and_ldrfilm_is_accepted() {
     assert_eq!(s.film.width, 8);
     assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
 }
+
+#[test]
+fn doctype_is_accepted_and_rotate_axis_conflict_is_reported() {
+    let xml = format!("<?xml version=\"1.0\"?>\n<!DOCTYPE scene>\n<scene version=\"0.6.0\">{SENSOR}{LIGHT}</scene>");
+    assert!(load(&xml).is_ok());
+    let e = m3_err(
+        r#"<shape type="cube"><transform name="to_world"><rotate axis="0,0,1" z="1" angle="3"/></transform></shape>"#,
+    );
+    assert!(e.contains("test.xml:2: <rotate"), "{e}");
+}

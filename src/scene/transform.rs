@@ -27,7 +27,7 @@ fn parse_op(op: &Element) -> Result<Mat4, SceneError> {
         "rotate" => {
             op.check_attrs(&["x", "y", "z", "axis", "angle"])?;
             let axis = match op.attr("axis") {
-                Some(a) if op.attr("x").is_some() || op.attr("y").is_some() => {
+                Some(a) if ["x", "y", "z"].iter().any(|k| op.attr(k).is_some()) => {
                     return Err(op.err(format!(
                         "give the axis either as axis=\"{a}\" or as x/y/z attributes"
                     )))

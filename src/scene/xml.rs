@@ -184,7 +184,12 @@ pub fn parse_document(
     file: &Path,
     defines: &[(String, String)],
 ) -> Result<Element, SceneError> {
-    let doc = roxmltree::Document::parse(xml).map_err(|e| SceneError {
+    // Some exported Mitsuba 0.6 scenes carry a DOCTYPE; it is harmless.
+    let options = roxmltree::ParsingOptions {
+        allow_dtd: true,
+        ..Default::default()
+    };
+    let doc = roxmltree::Document::parse_with_options(xml, options).map_err(|e| SceneError {
         file: file.to_path_buf(),
         line: Some(e.pos().row),
         element: None,
