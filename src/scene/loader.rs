@@ -8,7 +8,7 @@ use super::desc::*;
 use super::error::SceneError;
 use super::mesh::{self, TriMesh};
 use super::props::Plugin;
-use super::xml::{parse_document, Element};
+use super::xml::{parse_document, parse_float, Element};
 use glam::{Mat3, Mat4, Vec3};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -331,17 +331,8 @@ impl<'a> Loader<'a> {
             t if KNOWN_SENSORS.contains(&t) => return Err(unsupported(e, "sensor", t)),
             t => return Err(unknown(e, "sensor", t, "perspective")),
         }
-        p.reject("focal_length")?;
         p.reject("principal_point_offset_x")?;
         p.reject("principal_point_offset_y")?;
-        let fov = match p.float("fov")? {
-            Some(f) => f,
-            None if self.is_nori() => 30.0,
-            None => return Err(e.err("expected a 'fov' parameter (degrees)")),
-        };
-        if !(fov > 0.0 && fov < 180.0) {
-            return Err(e.err(format!("fov must be in (0, 180) degrees, found {fov}")));
-        }
         let fov_axis = match p.string("fov_axis")? {
             None => FovAxis::X,
             Some((s, se)) => match s.to_ascii_lowercase().as_str() {
@@ -357,6 +348,29 @@ impl<'a> Loader<'a> {
                 }
             },
         };
+        let (fov, fov_axis) = match (p.float("fov")?, p.string("focal_length")?) {
+            (Some(_), Some((_, fe))) => {
+                return Err(fe.err("give either 'fov' or 'focal_length', not both"))
+            }
+            (Some(f), None) => (f, fov_axis),
+            (None, _) if self.is_nori() => (30.0, fov_axis),
+            // Mitsuba's default is a 50 mm lens on 36x24 mm film, measured on the diagonal.
+            (None, fl) => {
+                let (text, fe) = fl.unwrap_or(("50mm".into(), e));
+                let mm = parse_float(text.trim().trim_end_matches("mm")).map_err(|m| fe.err(m))?;
+                if mm <= 0.0 {
+                    return Err(fe.err("focal_length must be positive"));
+                }
+                let diagonal = (36.0f32).hypot(24.0);
+                (
+                    2.0 * (diagonal / (2.0 * mm)).atan().to_degrees(),
+                    FovAxis::Diagonal,
+                )
+            }
+        };
+        if !(fov > 0.0 && fov < 180.0) {
+            return Err(e.err(format!("fov must be in (0, 180) degrees, found {fov}")));
+        }
         let near_clip = p
             .float("near_clip")?
             .unwrap_or(if self.is_nori() { 1e-4 } else { 0.01 });
@@ -654,9 +668,12 @@ impl<'a> Loader<'a> {
             t if KNOWN_EMITTERS.contains(&t) => return Err(unsupported(e, "emitter", t)),
             t => return Err(unknown(e, "emitter", t, "area (in a shape), point")),
         }
-        let radiance = p
-            .color("radiance")?
-            .ok_or_else(|| e.err("expected a 'radiance' parameter"))?;
+        // Mitsuba defaults to unit radiance; Nori requires it.
+        let radiance = match p.color("radiance")? {
+            Some(r) => r,
+            None if self.is_nori() => return Err(e.err("expected a 'radiance' parameter")),
+            None => Vec3::ONE,
+        };
         p.ignore(
             "sampling_weight",
             "emitters are chosen by power",

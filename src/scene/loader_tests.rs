@@ -451,7 +451,16 @@ fn area_emitters_and_point_lights() {
     assert_eq!(s.point_lights[1].position, Vec3::new(1.0, 2.0, 3.0));
     assert_eq!(s.point_lights[1].intensity, Vec3::splat(5.0));
 
-    let e = m3_err(r#"<shape type="rectangle"><emitter type="area"/></shape>"#);
+    let s = m3(r#"<shape type="rectangle"><emitter type="area"/></shape>"#);
+    assert_eq!(
+        s.shapes[0].emitter,
+        Some(AreaEmitterDesc {
+            radiance: Vec3::ONE
+        })
+    );
+    let e = load("<scene><camera type=\"perspective\"/>\n<mesh type=\"cube\"><emitter type=\"area\"/></mesh></scene>")
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("test.xml:2: <emitter type=\"area\">: expected a 'radiance'"),
         "{e}"
@@ -899,4 +908,26 @@ fn doctype_is_accepted_and_rotate_axis_conflict_is_reported() {
         r#"<shape type="cube"><transform name="to_world"><rotate axis="0,0,1" z="1" angle="3"/></transform></shape>"#,
     );
     assert!(e.contains("test.xml:2: <rotate"), "{e}");
+}
+
+#[test]
+fn focal_length_gives_a_diagonal_fov_like_mitsuba() {
+    let cam = |params: &str| {
+        load(&format!(
+            "<scene version=\"3.0.0\">{LIGHT}<sensor type=\"perspective\">{params}</sensor></scene>"
+        ))
+    };
+    // Mitsuba 3.9 reports x_fov 38.1848 for the default 768x576 film: the 50 mm default lens
+    // on the 43.27 mm diagonal of 36x24 mm film.
+    let c = cam("").unwrap().camera;
+    assert_eq!(c.fov_axis, FovAxis::Diagonal);
+    assert!((c.fov_degrees - 46.7930).abs() < 1e-3, "{}", c.fov_degrees);
+    let c = cam(r#"<string name="focal_length" value="35mm"/>"#)
+        .unwrap()
+        .camera;
+    assert!((c.fov_degrees - 2.0 * (43.26662f32 / 70.0).atan().to_degrees()).abs() < 1e-4);
+    let e = cam(r#"<float name="fov" value="40"/><string name="focal_length" value="35mm"/>"#)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("not both"), "{e}");
 }

@@ -9,7 +9,8 @@
 //! balance heuristic; Mitsuba: 768x576, 4 spp, near clip 0.01, power heuristic).
 //!
 //! Supported plugins: integrator `direct` (+ Nori's `sampling` string, `direct_ems`,
-//! `direct_mats`, `direct_mis`); sensor `perspective`; film `hdrfilm` (`ldrfilm` read as
+//! `direct_mats`, `direct_mis`); sensor `perspective` (fov, or Mitsuba's focal_length with its
+//! 50 mm default, which is a diagonal fov); film `hdrfilm` (`ldrfilm` read as
 //! hdrfilm); rfilter `box`, `tent`, `gaussian`; sampler `independent` (other Mitsuba samplers
 //! are replaced by it, with a warning); bsdf `diffuse`, `twosided`, `conductor`,
 //! `roughconductor`, `dielectric`, `mirror`, `microfacet`; shape `obj`, `rectangle`, `cube`,
