@@ -31,6 +31,7 @@ pub mod error;
 pub mod loader;
 pub mod mesh;
 pub mod props;
+mod sensor;
 pub mod transform;
 pub mod xml;
 
