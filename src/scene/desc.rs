@@ -49,15 +49,10 @@ pub struct CameraDesc {
 pub enum FilterDesc {
     Box,
     /// Tent of the given radius in pixels (Mitsuba default 1).
-    Tent {
-        radius: f32,
-    },
+    Tent { radius: f32 },
     /// Gaussian of the given standard deviation in pixels, truncated at `radius`
     /// (Mitsuba 3: stddev 0.5, radius 4*stddev; Nori: stddev 0.5, radius 2).
-    Gaussian {
-        stddev: f32,
-        radius: f32,
-    },
+    Gaussian { stddev: f32, radius: f32 },
 }
 
 #[derive(Clone, Debug, PartialEq)]
