@@ -11,7 +11,11 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 #[derive(Parser, Debug)]
-#[command(name = "directlab", version, about = "Monte Carlo direct illumination and its convergence harness")]
+#[command(
+    name = "directlab",
+    version,
+    about = "Monte Carlo direct illumination and its convergence harness"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -171,7 +175,9 @@ struct RenderStats {
 
 fn cmd_render(a: &RenderArgs) -> Result<(), String> {
     let scene = open_scene(&a.scene, &a.define)?;
-    let strategy = a.strategy.apply(Strategy::from_desc(&scene.desc.integrator));
+    let strategy = a
+        .strategy
+        .apply(Strategy::from_desc(&scene.desc.integrator));
     let settings = RenderSettings {
         spp: a.spp.unwrap_or(scene.desc.sampler.sample_count).max(1),
         seed: a.seed.unwrap_or(scene.desc.sampler.seed),
@@ -179,7 +185,12 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
         progress: std::io::stderr().is_terminal(),
     };
     let out = a.out.clone().unwrap_or_else(|| {
-        let stem = a.scene.file_stem().unwrap_or_default().to_string_lossy().to_string();
+        let stem = a
+            .scene
+            .file_stem()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .to_string();
         PathBuf::from(format!("{stem}.exr"))
     });
     let result = render(&scene, strategy, &settings);
@@ -203,7 +214,9 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
     };
     if let Some(p) = &a.stats {
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
-        film::write_atomic(p, |tmp| std::fs::write(tmp, json).map_err(|e| format!("{}: {e}", p.display())))?;
+        film::write_atomic(p, |tmp| {
+            std::fs::write(tmp, json).map_err(|e| format!("{}: {e}", p.display()))
+        })?;
     }
     eprintln!(
         "{}: {}x{} at {} spp with {} in {:.2} s ({:.2} M samples/s) -> {}",
@@ -217,7 +230,10 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
         out.display()
     );
     if result.non_finite_samples > 0 {
-        eprintln!("warning: {} non-finite samples were replaced by 0", result.non_finite_samples);
+        eprintln!(
+            "warning: {} non-finite samples were replaced by 0",
+            result.non_finite_samples
+        );
     }
     Ok(())
 }

@@ -6,11 +6,13 @@
 pub mod analytic;
 pub mod bsdf;
 pub mod camera;
+pub mod cli;
 pub mod emitter;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
 pub mod math;
+pub mod metrics;
 pub mod render;
 pub mod rng;
 pub mod sampling;

@@ -1,0 +1,146 @@
+//! Error metrics between images, and a test that two renders have the same expectation.
+
+use crate::film::Image;
+use statrs::distribution::{ContinuousCDF, Normal};
+
+/// Mean squared error over all pixels and channels.
+pub fn mse(img: &Image, reference: &Image) -> f64 {
+    assert_eq!((img.width, img.height), (reference.width, reference.height));
+    let s: f64 = img
+        .data
+        .iter()
+        .zip(&reference.data)
+        .map(|(a, r)| (0..3).map(|c| (a[c] - r[c]).powi(2)).sum::<f64>())
+        .sum();
+    s / (3.0 * img.data.len() as f64)
+}
+
+/// Relative MSE: mean of (x - r)^2 / (r^2 + eps) over pixels and channels. `eps` keeps dark
+/// pixels from dominating; always report it with the number (0.01 is common).
+pub fn rel_mse(img: &Image, reference: &Image, eps: f64) -> f64 {
+    assert_eq!((img.width, img.height), (reference.width, reference.height));
+    let s: f64 = img
+        .data
+        .iter()
+        .zip(&reference.data)
+        .map(|(a, r)| {
+            (0..3)
+                .map(|c| (a[c] - r[c]).powi(2) / (r[c] * r[c] + eps))
+                .sum::<f64>()
+        })
+        .sum();
+    s / (3.0 * img.data.len() as f64)
+}
+
+/// Outcome of comparing two independent renders region by region.
+#[derive(Clone, Debug)]
+pub struct RegionComparison {
+    /// Number of (region, channel) tests.
+    pub tests: usize,
+    /// The largest |z| and where: (region x, region y, channel).
+    pub max_abs_z: f64,
+    pub worst: (u32, u32, usize),
+    /// Two-sided critical |z| at the requested level, Sidak-corrected over `tests`.
+    pub critical_z: f64,
+}
+
+impl RegionComparison {
+    pub fn passed(&self) -> bool {
+        self.max_abs_z < self.critical_z
+    }
+}
+
+/// z-tests of the region means of two independent renders, each given as its per-pixel mean
+/// and variance-of-the-mean images. Region means of many pixels are close to normal, so
+/// z = (mean_a - mean_b) / sqrt(var_a + var_b) per region and channel. Regions where both
+/// variances are zero must agree to 1e-6 relative. `alpha` is Sidak-corrected.
+pub fn compare_regions(
+    a: (&Image, &Image),
+    b: (&Image, &Image),
+    region: u32,
+    alpha: f64,
+) -> RegionComparison {
+    let (w, h) = (a.0.width, a.0.height);
+    assert_eq!((w, h), (b.0.width, b.0.height));
+    let (rx, ry) = (w.div_ceil(region), h.div_ceil(region));
+    let tests = (rx * ry * 3) as usize;
+    let mut out = RegionComparison {
+        tests,
+        max_abs_z: 0.0,
+        worst: (0, 0, 0),
+        critical_z: 0.0,
+    };
+    for gy in 0..ry {
+        for gx in 0..rx {
+            let mut s = [[0.0f64; 3]; 4];
+            let mut n = 0.0;
+            for y in gy * region..((gy + 1) * region).min(h) {
+                for x in gx * region..((gx + 1) * region).min(w) {
+                    n += 1.0;
+                    for (k, img) in [a.0, a.1, b.0, b.1].iter().enumerate() {
+                        let p = img.get(x, y);
+                        for c in 0..3 {
+                            s[k][c] += p[c];
+                        }
+                    }
+                }
+            }
+            let [mean_a, var_a, mean_b, var_b] = s;
+            for c in 0..3 {
+                let diff = (mean_a[c] - mean_b[c]) / n;
+                let var = (var_a[c] + var_b[c]) / (n * n);
+                let z = if var > 0.0 {
+                    diff.abs() / var.sqrt()
+                } else if diff.abs() <= 1e-6 * (mean_a[c] / n).abs().max(1e-12) {
+                    0.0
+                } else {
+                    f64::INFINITY
+                };
+                if z > out.max_abs_z {
+                    out.max_abs_z = z;
+                    out.worst = (gx, gy, c);
+                }
+            }
+        }
+    }
+    let a_sidak = 1.0 - (1.0 - alpha).powf(1.0 / tests as f64);
+    out.critical_z = Normal::new(0.0, 1.0)
+        .expect("standard normal")
+        .inverse_cdf(1.0 - a_sidak / 2.0);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn constant(v: f64) -> Image {
+        let mut i = Image::new(4, 4);
+        i.data.iter_mut().for_each(|p| *p = [v; 3]);
+        i
+    }
+
+    #[test]
+    fn mse_and_rel_mse() {
+        let (a, r) = (constant(1.5), constant(1.0));
+        assert!((mse(&a, &r) - 0.25).abs() < 1e-12);
+        assert!((rel_mse(&a, &r, 0.0) - 0.25).abs() < 1e-12);
+        assert!((rel_mse(&a, &r, 1.0) - 0.125).abs() < 1e-12);
+    }
+
+    #[test]
+    fn region_comparison_detects_a_shift_larger_than_the_noise() {
+        let var = constant(1e-4);
+        let same = compare_regions((&constant(1.0), &var), (&constant(1.001), &var), 2, 0.01);
+        assert!(same.passed(), "{same:?}");
+        let shifted = compare_regions((&constant(1.0), &var), (&constant(1.1), &var), 2, 0.01);
+        assert!(!shifted.passed(), "{shifted:?}");
+        let zero = constant(0.0);
+        assert!(
+            compare_regions((&constant(1.0), &zero), (&constant(1.0), &zero), 2, 0.01).passed()
+        );
+        assert!(
+            !compare_regions((&constant(1.0), &zero), (&constant(1.01), &zero), 2, 0.01).passed()
+        );
+    }
+}
