@@ -107,12 +107,14 @@ fn sample_eval_pdf_agree() {
 fn furnace_and_pdf_mass() {
     let n = 40_000;
     let (mut worst_albedo, mut worst_mass, mut min_albedo) = (0.0f64, 0.0f64, 1.0f32);
+    let mut worst_z = 0.0f64;
     for (name, m, a) in cases() {
         for wi in incident() {
             let (mc, se) = albedo(&m, wi, n);
             let (quad, mass) = quadrature(&m, wi, &lobe_grid(wi, a));
             let d = (mc.x - quad.x).abs() as f64;
             worst_albedo = worst_albedo.max(d);
+            worst_z = worst_z.max(d / (4.0 * se.x as f64 + 2e-3));
             assert!(
                 d < 4.0 * se.x as f64 + 2e-3,
                 "{name} {wi}: albedo mc {mc} ± {se}, quadrature {quad}"
@@ -136,8 +138,9 @@ fn furnace_and_pdf_mass() {
         }
     }
     eprintln!(
-        "roughconductor: worst |albedo mc - quad| {worst_albedo:.2e}, worst |success - pdf mass| \
-         {worst_mass:.2e}, smallest lossless albedo {min_albedo:.4}"
+        "roughconductor: worst |albedo mc - quad| {worst_albedo:.2e} (at most {worst_z:.2} of \
+         the tolerance), worst |success - pdf mass| {worst_mass:.2e}, smallest lossless albedo \
+         {min_albedo:.4}"
     );
 }
 
@@ -204,4 +207,65 @@ fn sampled_directions_match_pdf_chi2() {
         "roughconductor chi2: {} cases, smallest p {smallest:.3e}",
         runs.len()
     );
+}
+
+/// The pdf that `sample` reports is evaluated at the returned wo; here the density is
+/// derived independently from the drawn normal (pdf_m(m) / (4 wi.m), the reflection
+/// Jacobian) and compared, away from the grazing f32 limit (cos_i >= 0.1, alpha >= 0.01).
+#[test]
+fn reported_pdf_matches_drawn_normal_density() {
+    let mut rng = crate::rng::Rng::new(4, 4);
+    let mut worst = 0.0f32;
+    for d in DISTS {
+        for a in [(0.01, 0.01), (0.2, 0.2), (1.0, 1.0), (0.05, 0.4)] {
+            let mf = Microfacet::new(d, a.0, a.1);
+            for vis in [true, false] {
+                let m = rough(d, a, vis, Rgb::ONE);
+                for wi in incident().into_iter().take(3) {
+                    for _ in 0..5_000 {
+                        let u = rng.next_2d();
+                        let h = if vis {
+                            mf.sample_visible(wi, u)
+                        } else {
+                            mf.sample_all(u)
+                        };
+                        let Some(s) = m.sample(wi, 0.5, u) else {
+                            continue;
+                        };
+                        let pm = if vis {
+                            mf.pdf_visible(wi, h)
+                        } else {
+                            mf.pdf_all(h)
+                        };
+                        let want = pm / (4.0 * wi.dot(h));
+                        let e = (s.pdf - want).abs() / want;
+                        worst = worst.max(e);
+                        assert!(e < 1e-3, "{d:?} {a:?} {vis} {wi}: {} vs {want}", s.pdf);
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("roughconductor: worst pdf(wo) vs pdf_m/(4 wi.m) {worst:.2e}");
+}
+
+/// Cost per `sample` call (run with --ignored --nocapture; release-like test profile).
+#[test]
+#[ignore]
+fn timing() {
+    let wi = Vec3::new(0.3, 0.2, 0.9).normalize();
+    for (name, m, _) in cases().into_iter().filter(|c| c.2 .0 == 0.1) {
+        let mut rng = crate::rng::Rng::new(1, 2);
+        let t = std::time::Instant::now();
+        let mut acc = 0.0;
+        for _ in 0..1_000_000 {
+            if let Some(s) = m.sample(wi, rng.next_f32(), rng.next_2d()) {
+                acc += s.weight.x;
+            }
+        }
+        eprintln!(
+            "{name}: {:.0} ns/sample ({acc})",
+            t.elapsed().as_nanos() as f64 / 1e6
+        );
+    }
 }

@@ -168,3 +168,20 @@ fn samplers_match_their_pdfs_chi2() {
         cases.len()
     );
 }
+
+/// Cost guard: the Beckmann visible-slope inversion converges in a few Newton steps.
+#[test]
+fn beckmann_newton_iterations() {
+    let mf = Microfacet::new(MicrofacetDistribution::Beckmann, 0.1, 0.1);
+    let mut rng = crate::rng::Rng::new(1, 1);
+    for c in [1.0f32, 0.7, 0.3, 0.01] {
+        let wi = Vec3::new((1.0 - c * c).sqrt(), 0.0, c);
+        ITERS.with(|i| i.set(0));
+        for _ in 0..10_000 {
+            mf.sample_visible(wi, rng.next_2d());
+        }
+        let per = ITERS.with(|i| i.get()) as f64 / 1e4;
+        eprintln!("cos {c}: {per} Newton iterations per sample");
+        assert!(per < 8.0, "{per}");
+    }
+}
