@@ -190,7 +190,6 @@ thread_local!(pub static ITERS: std::cell::Cell<u64> = const { std::cell::Cell::
 ///   C(x) = erfc(-x) + tan(theta) / sqrt(pi) exp(-x^2).
 /// Safeguarded Newton (bisection fallback) stops at steps below 1e-9, far finer than the f32
 /// normal it feeds.
-
 fn beckmann_visible_slope(tan_t: f64, u: f64) -> f64 {
     let k = tan_t / PI.sqrt();
     let cdf = |x: f64| erfc(-x) + k * (-x * x).exp();
