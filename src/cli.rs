@@ -25,6 +25,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a Mitsuba 3, Mitsuba 0.6 or Nori XML scene to EXR (plus an sRGB PNG preview).
     Render(RenderArgs),
+    /// Measure render throughput per strategy and thread count.
+    Bench(crate::bench::BenchArgs),
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -243,6 +245,7 @@ pub fn main() -> i32 {
     let cli = Cli::parse();
     let r = match &cli.command {
         Command::Render(a) => cmd_render(a),
+        Command::Bench(a) => crate::bench::run(a),
     };
     match r {
         Ok(()) => 0,

@@ -185,11 +185,11 @@ impl Scene {
                             ),
                         ));
                     }
-                    ShapeKind::Mesh(Mesh {
-                        positions: positions.clone(),
-                        normals: normals.clone(),
-                        indices: indices.clone(),
-                    })
+                    ShapeKind::Mesh(Mesh::new(
+                        positions.clone(),
+                        normals.clone(),
+                        indices.clone(),
+                    ))
                 }
                 ShapeGeometry::Sphere {
                     center,
