@@ -236,6 +236,13 @@ pub fn transform(desc: &mut SceneDesc, m: Mat4) {
     desc.camera.to_world = m * desc.camera.to_world;
 }
 
+/// Just these shapes (and a 1x1 camera that nothing depends on): for testing light sampling
+/// on its own, where no receiver or floor should be in the way.
+pub fn shapes_only(shapes: Vec<ShapeDesc>) -> SceneDesc {
+    let cam = look_at(Vec3::new(0.0, 0.0, -10.0), Vec3::ZERO, Vec3::Y);
+    base(cam, 30.0, 1, 1, shapes)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
