@@ -1,0 +1,270 @@
+//! Markdown reports: `reports/<experiment>/index.md` (settings, reference and its noise,
+//! what was left out and why, tables, figures) and `reports/index.md` linking them all.
+
+use crate::experiment::analysis::{
+    error_of, mean_difference, metric_name, pooled_means, MeanDiff, PooledMean, Series,
+};
+use crate::experiment::figures::Figure;
+use crate::experiment::results::{Row, EQUAL_TIME};
+use crate::experiment::Outcome;
+use crate::film::write_atomic;
+use crate::stats::sidak;
+use std::fmt::Write;
+use std::path::Path;
+
+/// Family-wise level of the mean check.
+pub const MEAN_ALPHA: f64 = 0.01;
+
+const CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+fn e(v: f64) -> String {
+    format!("{v:.3e}")
+}
+
+/// Each strategy's image mean against the first strategy's, per channel, Sidak-corrected over
+/// all comparisons: (pooled means, per other strategy its differences, per-test alpha).
+pub fn mean_check(rows: &[Row], order: &[(String, String)]) -> (Vec<PooledMean>, Vec<Vec<MeanDiff>>, f64) {
+    let pm = pooled_means(rows, order);
+    let tests = 3 * pm.len().saturating_sub(1);
+    let alpha = if tests > 0 { sidak(MEAN_ALPHA, tests) } else { MEAN_ALPHA };
+    let diffs = pm
+        .iter()
+        .skip(1)
+        .map(|b| mean_difference(b, &pm[0], alpha))
+        .collect();
+    (pm, diffs, alpha)
+}
+
+/// Lines stating each difference with its 95 % interval, for the terminal and the report.
+pub fn mean_check_lines(rows: &[Row], order: &[(String, String)]) -> Vec<String> {
+    let (pm, diffs, alpha) = mean_check(rows, order);
+    let mut out = Vec::new();
+    for (b, ds) in pm.iter().skip(1).zip(&diffs) {
+        let a = &pm[0];
+        for d in ds {
+            let c = d.channel;
+            out.push(format!(
+                "mean({}) - mean({}) [{}] = {:+.4e} +- {:.2e} (95% CI), z = {:+.2}: {}",
+                b.name,
+                a.name,
+                CHANNELS[c],
+                d.diff,
+                d.half_width_95,
+                d.z,
+                if d.consistent {
+                    "consistent (same expectation)".to_string()
+                } else {
+                    format!("DIFFERENT at family-wise alpha {MEAN_ALPHA} (per test {alpha:.1e}): one of them is biased")
+                }
+            ));
+        }
+    }
+    out
+}
+
+fn settings(md: &mut String, o: &Outcome) {
+    let x = &o.exp.exp;
+    let defines: Vec<String> = o.exp.defines.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    let _ = writeln!(md, "## Settings\n");
+    let _ = writeln!(
+        md,
+        "- Scene: `{}`{} ({}x{} pixels)",
+        o.exp.scene.display(),
+        if defines.is_empty() {
+            String::new()
+        } else {
+            format!(" with `-D {}`", defines.join(" -D "))
+        },
+        o.width,
+        o.height
+    );
+    let _ = writeln!(md, "- Experiment file: `{}`{}", o.exp.file.display(), if o.exp.quick { " (`--quick`)" } else { "" });
+    let _ = writeln!(md, "- Sweep: spp {:?}, seeds 0..{}", x.spp, x.seeds);
+    let _ = writeln!(
+        md,
+        "- Error: {}; relMSE = mean((x - r)^2 / (r^2 + eps)) with eps = {}; both are corrected \
+         for the reference's own noise (below).",
+        metric_name(x.metrics.primary, x.metrics.relmse_epsilon),
+        x.metrics.relmse_epsilon
+    );
+    let ri = &o.reference.info;
+    let _ = writeln!(
+        md,
+        "- Reference: `{}` at {} spp, seed {}, {:.1} s to render ({}), {} non-finite samples; \
+         cache key `{}`.",
+        ri.strategy,
+        ri.spp,
+        ri.seed,
+        ri.seconds,
+        if o.reference.cached { "from the cache" } else { "rendered in this run" },
+        ri.non_finite_samples,
+        ri.key
+    );
+    let near = o.rows.iter().filter(|r| r.near_floor).count();
+    let _ = writeln!(
+        md,
+        "- Reference noise floor: mean per-pixel variance {} (MSE), {} (relMSE). A run's \
+         measured MSE estimates its true MSE plus this floor (the two renders are independent), \
+         so the floor is subtracted. {}",
+        e(ri.mse_floor),
+        e(ri.relmse_floor),
+        if near == 0 {
+            "No run came within 2x of the floor.".to_string()
+        } else {
+            format!("**Warning:** {near} of {} runs measured an error within 2x of the floor; their corrected errors are unreliable and are left out of the slope fits.", o.rows.len())
+        }
+    );
+    let _ = writeln!(
+        md,
+        "- This invocation rendered {} runs ({} came from `results.csv`) in {:.1} s.\n",
+        o.rendered,
+        o.rows.len() - o.rendered.min(o.rows.len()),
+        o.seconds
+    );
+}
+
+fn left_out(md: &mut String, o: &Outcome) {
+    let _ = writeln!(md, "## Left out\n");
+    if o.omitted.is_empty() {
+        let _ = writeln!(md, "Nothing: every listed strategy is a different estimator on this scene.\n");
+        return;
+    }
+    for om in &o.omitted {
+        let _ = writeln!(md, "- **{}** (`{}`): {}", om.name, om.label, om.reason);
+    }
+    md.push('\n');
+}
+
+fn error_table(md: &mut String, o: &Outcome, series: &[Series]) {
+    let x = &o.exp.exp;
+    let what = metric_name(x.metrics.primary, x.metrics.relmse_epsilon);
+    let _ = writeln!(md, "## Error per spp\n\n{what}, mean over seeds (corrected for the reference noise; * marks runs within 2x of the floor).\n");
+    let mut head = "| strategy | label | slope |".to_string();
+    let mut rule = "|---|---|---|".to_string();
+    for spp in &x.spp {
+        let _ = write!(head, " {spp} spp |");
+        rule.push_str("---|");
+    }
+    let _ = writeln!(md, "{head} samples/s |\n{rule}---|");
+    for s in series {
+        let mut line = format!(
+            "| {} | `{}` | {} |",
+            s.name,
+            s.label,
+            s.slope.map_or("-".into(), |k| format!("{k:.2}"))
+        );
+        for spp in &x.spp {
+            match s.points.iter().find(|p| p.spp == *spp) {
+                Some(p) => {
+                    let _ = write!(line, " {}{} |", e(p.error), if p.near_floor { "*" } else { "" });
+                }
+                None => line.push_str(" - |"),
+            }
+        }
+        let (n, t) = o
+            .rows
+            .iter()
+            .filter(|r| r.is_sweep() && r.strategy == s.label)
+            .fold((0.0, 0.0), |(n, t), r| (n + r.samples_per_s * r.seconds, t + r.seconds));
+        let _ = writeln!(line, " {:.2e} |", if t > 0.0 { n / t } else { 0.0 });
+        md.push_str(&line);
+    }
+    md.push('\n');
+}
+
+fn equal_time_table(md: &mut String, o: &Outcome) {
+    let rows: Vec<&Row> = o.rows.iter().filter(|r| r.kind == EQUAL_TIME).collect();
+    if rows.is_empty() {
+        return;
+    }
+    let m = o.exp.exp.metrics.primary;
+    let what = metric_name(m, o.exp.exp.metrics.relmse_epsilon);
+    let _ = writeln!(md, "## Equal time\n\nspp chosen from each strategy's measured sample rate.\n\n| budget (s) | strategy | seed | spp | seconds | {what} |\n|---|---|---|---|---|---|");
+    for r in rows {
+        let _ = writeln!(md, "| {} | {} | {} | {} | {:.2} | {} |", r.budget_s, r.name, r.seed, r.spp, r.seconds, e(error_of(r, m)));
+    }
+    md.push('\n');
+}
+
+fn variance_table(md: &mut String, o: &Outcome) {
+    let spp = o.exp.equal_spp();
+    let _ = writeln!(md, "## Variance of the image mean at {spp} spp\n\nFrom the per-pixel variance images (pixels are independent, so Var(image mean) = sum of pixel variances / pixels^2), averaged over seeds; x spp gives the per-sample value, x seconds the cost-weighted value (lower is better).\n\n| strategy | Var R | Var G | Var B | Var G x spp | Var G x seconds |\n|---|---|---|---|---|---|");
+    for (label, name) in &o.strategies {
+        let rs: Vec<&Row> = o.rows.iter().filter(|r| r.is_sweep() && &r.strategy == label && r.spp == spp).collect();
+        if rs.is_empty() || spp < 2 {
+            continue;
+        }
+        let n = rs.len() as f64;
+        let v = [0, 1, 2].map(|c| rs.iter().map(|r| r.mean_var()[c]).sum::<f64>() / n);
+        let secs = rs.iter().map(|r| r.seconds).sum::<f64>() / n;
+        let _ = writeln!(md, "| {name} | {} | {} | {} | {} | {} |", e(v[0]), e(v[1]), e(v[2]), e(v[1] * spp as f64), e(v[1] * secs));
+    }
+    md.push('\n');
+}
+
+fn means(md: &mut String, o: &Outcome) {
+    let (pm, _, _) = mean_check(&o.rows, &o.strategies);
+    if pm.is_empty() {
+        return;
+    }
+    let _ = writeln!(md, "## Same expectation?\n\nEvery correct strategy converges to the same image, so their image means must agree within noise (a difference is a bias, not an improvement). Each strategy's image mean at its highest spp, pooled over seeds, with a 95 % interval from its variance images:\n\n| strategy | spp x seeds | mean R | mean G | mean B |\n|---|---|---|---|---|");
+    for p in &pm {
+        let cell = |c: usize| format!("{:.5e} +- {:.1e}", p.mean[c], 1.959_964 * p.var[c].sqrt());
+        let _ = writeln!(md, "| {} | {} x {} | {} | {} | {} |", p.name, p.spp, p.seeds, cell(0), cell(1), cell(2));
+    }
+    let r = o.reference.mean.mean_rgb();
+    let _ = writeln!(md, "| reference | {} | {:.5e} | {:.5e} | {:.5e} |\n", o.reference.info.spp, r[0], r[1], r[2]);
+    for l in mean_check_lines(&o.rows, &o.strategies) {
+        let _ = writeln!(md, "- {l}");
+    }
+    md.push('\n');
+}
+
+/// Writes `<dir>/index.md`.
+pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> Result<(), String> {
+    let mut md = String::new();
+    let title = o.exp.exp.title.clone().unwrap_or_else(|| o.exp.name.clone());
+    let _ = writeln!(md, "# {title}\n");
+    if !o.exp.exp.description.is_empty() {
+        let _ = writeln!(md, "{}\n", o.exp.exp.description.trim());
+    }
+    settings(&mut md, o);
+    left_out(&mut md, o);
+    error_table(&mut md, o, series);
+    equal_time_table(&mut md, o);
+    means(&mut md, o);
+    variance_table(&mut md, o);
+    let _ = writeln!(md, "## Figures\n");
+    for f in figures {
+        let _ = writeln!(md, "![{}]({})\n\n{}\n", f.file, f.file, f.caption);
+    }
+    let _ = writeln!(md, "Raw numbers: [results.csv](results.csv), one row per render.");
+    let path = o.dir.join("index.md");
+    write_atomic(&path, |tmp| std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display())))
+}
+
+/// Writes `<root>/index.md` linking every experiment folder that has a report.
+pub fn write_root_index(root: &Path) -> Result<(), String> {
+    let mut entries: Vec<(String, String)> = Vec::new();
+    if let Ok(rd) = std::fs::read_dir(root) {
+        for d in rd.flatten() {
+            let idx = d.path().join("index.md");
+            let Ok(text) = std::fs::read_to_string(&idx) else { continue };
+            let name = d.file_name().to_string_lossy().to_string();
+            let title = text
+                .lines()
+                .next()
+                .and_then(|l| l.strip_prefix("# "))
+                .unwrap_or(&name)
+                .to_string();
+            entries.push((name, title));
+        }
+    }
+    entries.sort();
+    let mut md = String::from("# Experiments\n\nWritten by `directlab run` / `directlab reproduce`.\n\n");
+    for (name, title) in &entries {
+        let _ = writeln!(md, "- [{title}]({name}/index.md)");
+    }
+    let path = root.join("index.md");
+    write_atomic(&path, |tmp| std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display())))
+}
