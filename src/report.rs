@@ -21,37 +21,80 @@ fn e(v: f64) -> String {
     format!("{v:.3e}")
 }
 
-/// Each strategy's image mean against the first strategy's, per channel, Sidak-corrected over
-/// all comparisons: (pooled means, per other strategy its differences, per-test alpha).
-pub fn mean_check(rows: &[Row], order: &[(String, String)]) -> (Vec<PooledMean>, Vec<Vec<MeanDiff>>, f64) {
-    let pm = pooled_means(rows, order);
-    let tests = 3 * pm.len().saturating_sub(1);
-    let alpha = if tests > 0 { sidak(MEAN_ALPHA, tests) } else { MEAN_ALPHA };
-    let diffs = pm
+/// One comparison of image means: `a - b` per channel.
+pub struct Comparison {
+    pub a: String,
+    pub b: String,
+    pub diffs: Vec<MeanDiff>,
+}
+
+/// The reference as a pooled mean, its variance from its own variance image.
+fn reference_mean(o: &Outcome) -> PooledMean {
+    let r = &o.reference;
+    let n = r.mean.data.len() as f64;
+    let mut var = [0.0; 3];
+    for v in &r.variance.data {
+        for c in 0..3 {
+            var[c] += v[c] / (n * n);
+        }
+    }
+    PooledMean {
+        label: "reference".into(),
+        name: "reference".into(),
+        spp: r.info.spp,
+        seeds: 1,
+        mean: r.mean.mean_rgb(),
+        var,
+    }
+}
+
+/// Every strategy's image mean against the first strategy's and against the reference's, per
+/// channel, Sidak-corrected over all tests at family-wise level `MEAN_ALPHA`.
+pub fn mean_check(o: &Outcome) -> (Vec<PooledMean>, Vec<Comparison>, f64) {
+    let pm = pooled_means(&o.rows, &o.strategies);
+    let reference = reference_mean(o);
+    let mut pairs: Vec<(&PooledMean, &PooledMean)> =
+        pm.iter().skip(1).map(|b| (b, &pm[0])).collect();
+    pairs.extend(pm.iter().map(|a| (a, &reference)));
+    let tests = 3 * pairs.len();
+    let alpha = if tests > 0 {
+        sidak(MEAN_ALPHA, tests)
+    } else {
+        MEAN_ALPHA
+    };
+    let comparisons = pairs
         .iter()
-        .skip(1)
-        .map(|b| mean_difference(b, &pm[0], alpha))
+        .map(|(a, b)| Comparison {
+            a: a.name.clone(),
+            b: b.name.clone(),
+            diffs: mean_difference(a, b, alpha),
+        })
         .collect();
-    (pm, diffs, alpha)
+    let mut all = pm;
+    all.push(reference);
+    (all, comparisons, alpha)
 }
 
 /// Lines stating each difference with its 95 % interval, for the terminal and the report.
-pub fn mean_check_lines(rows: &[Row], order: &[(String, String)]) -> Vec<String> {
-    let (pm, diffs, alpha) = mean_check(rows, order);
+/// Channels with identical numbers (grey scenes) are stated once.
+pub fn mean_check_lines(o: &Outcome) -> Vec<String> {
+    let (_, comparisons, alpha) = mean_check(o);
     let mut out = Vec::new();
-    for (b, ds) in pm.iter().skip(1).zip(&diffs) {
-        let a = &pm[0];
-        for d in ds {
-            let c = d.channel;
+    for cmp in &comparisons {
+        let d = &cmp.diffs;
+        let grey = d
+            .iter()
+            .all(|x| x.diff == d[0].diff && x.half_width_95 == d[0].half_width_95);
+        for x in if grey { &d[..1] } else { &d[..] } {
+            let ch = if grey { "RGB" } else { CHANNELS[x.channel] };
             out.push(format!(
-                "mean({}) - mean({}) [{}] = {:+.4e} +- {:.2e} (95% CI), z = {:+.2}: {}",
-                b.name,
-                a.name,
-                CHANNELS[c],
-                d.diff,
-                d.half_width_95,
-                d.z,
-                if d.consistent {
+                "mean({}) - mean({}) [{ch}] = {:+.4e} +- {:.2e} (95% CI), z = {:+.2}: {}",
+                cmp.a,
+                cmp.b,
+                x.diff,
+                x.half_width_95,
+                x.z,
+                if x.consistent {
                     "consistent (same expectation)".to_string()
                 } else {
                     format!("DIFFERENT at family-wise alpha {MEAN_ALPHA} (per test {alpha:.1e}): one of them is biased")
@@ -64,7 +107,12 @@ pub fn mean_check_lines(rows: &[Row], order: &[(String, String)]) -> Vec<String>
 
 fn settings(md: &mut String, o: &Outcome) {
     let x = &o.exp.exp;
-    let defines: Vec<String> = o.exp.defines.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    let defines: Vec<String> = o
+        .exp
+        .defines
+        .iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect();
     let _ = writeln!(md, "## Settings\n");
     let _ = writeln!(
         md,
@@ -78,7 +126,12 @@ fn settings(md: &mut String, o: &Outcome) {
         o.width,
         o.height
     );
-    let _ = writeln!(md, "- Experiment file: `{}`{}", o.exp.file.display(), if o.exp.quick { " (`--quick`)" } else { "" });
+    let _ = writeln!(
+        md,
+        "- Experiment file: `{}`{}",
+        o.exp.file.display(),
+        if o.exp.quick { " (`--quick`)" } else { "" }
+    );
     let _ = writeln!(md, "- Sweep: spp {:?}, seeds 0..{}", x.spp, x.seeds);
     let _ = writeln!(
         md,
@@ -96,7 +149,11 @@ fn settings(md: &mut String, o: &Outcome) {
         ri.spp,
         ri.seed,
         ri.seconds,
-        if o.reference.cached { "from the cache" } else { "rendered in this run" },
+        if o.reference.cached {
+            "from the cache"
+        } else {
+            "rendered in this run"
+        },
         ri.non_finite_samples,
         ri.key
     );
@@ -126,7 +183,10 @@ fn settings(md: &mut String, o: &Outcome) {
 fn left_out(md: &mut String, o: &Outcome) {
     let _ = writeln!(md, "## Left out\n");
     if o.omitted.is_empty() {
-        let _ = writeln!(md, "Nothing: every listed strategy is a different estimator on this scene.\n");
+        let _ = writeln!(
+            md,
+            "Nothing: every listed strategy is a different estimator on this scene.\n"
+        );
         return;
     }
     for om in &o.omitted {
@@ -156,7 +216,12 @@ fn error_table(md: &mut String, o: &Outcome, series: &[Series]) {
         for spp in &x.spp {
             match s.points.iter().find(|p| p.spp == *spp) {
                 Some(p) => {
-                    let _ = write!(line, " {}{} |", e(p.error), if p.near_floor { "*" } else { "" });
+                    let _ = write!(
+                        line,
+                        " {}{} |",
+                        e(p.error),
+                        if p.near_floor { "*" } else { "" }
+                    );
                 }
                 None => line.push_str(" - |"),
             }
@@ -165,7 +230,9 @@ fn error_table(md: &mut String, o: &Outcome, series: &[Series]) {
             .rows
             .iter()
             .filter(|r| r.is_sweep() && r.strategy == s.label)
-            .fold((0.0, 0.0), |(n, t), r| (n + r.samples_per_s * r.seconds, t + r.seconds));
+            .fold((0.0, 0.0), |(n, t), r| {
+                (n + r.samples_per_s * r.seconds, t + r.seconds)
+            });
         let _ = writeln!(line, " {:.2e} |", if t > 0.0 { n / t } else { 0.0 });
         md.push_str(&line);
     }
@@ -181,7 +248,16 @@ fn equal_time_table(md: &mut String, o: &Outcome) {
     let what = metric_name(m, o.exp.exp.metrics.relmse_epsilon);
     let _ = writeln!(md, "## Equal time\n\nspp chosen from each strategy's measured sample rate.\n\n| budget (s) | strategy | seed | spp | seconds | {what} |\n|---|---|---|---|---|---|");
     for r in rows {
-        let _ = writeln!(md, "| {} | {} | {} | {} | {:.2} | {} |", r.budget_s, r.name, r.seed, r.spp, r.seconds, e(error_of(r, m)));
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {:.2} | {} |",
+            r.budget_s,
+            r.name,
+            r.seed,
+            r.spp,
+            r.seconds,
+            e(error_of(r, m))
+        );
     }
     md.push('\n');
 }
@@ -190,31 +266,51 @@ fn variance_table(md: &mut String, o: &Outcome) {
     let spp = o.exp.equal_spp();
     let _ = writeln!(md, "## Variance of the image mean at {spp} spp\n\nFrom the per-pixel variance images (pixels are independent, so Var(image mean) = sum of pixel variances / pixels^2), averaged over seeds; x spp gives the per-sample value, x seconds the cost-weighted value (lower is better).\n\n| strategy | Var R | Var G | Var B | Var G x spp | Var G x seconds |\n|---|---|---|---|---|---|");
     for (label, name) in &o.strategies {
-        let rs: Vec<&Row> = o.rows.iter().filter(|r| r.is_sweep() && &r.strategy == label && r.spp == spp).collect();
+        let rs: Vec<&Row> = o
+            .rows
+            .iter()
+            .filter(|r| r.is_sweep() && &r.strategy == label && r.spp == spp)
+            .collect();
         if rs.is_empty() || spp < 2 {
             continue;
         }
         let n = rs.len() as f64;
         let v = [0, 1, 2].map(|c| rs.iter().map(|r| r.mean_var()[c]).sum::<f64>() / n);
         let secs = rs.iter().map(|r| r.seconds).sum::<f64>() / n;
-        let _ = writeln!(md, "| {name} | {} | {} | {} | {} | {} |", e(v[0]), e(v[1]), e(v[2]), e(v[1] * spp as f64), e(v[1] * secs));
+        let _ = writeln!(
+            md,
+            "| {name} | {} | {} | {} | {} | {} |",
+            e(v[0]),
+            e(v[1]),
+            e(v[2]),
+            e(v[1] * spp as f64),
+            e(v[1] * secs)
+        );
     }
     md.push('\n');
 }
 
 fn means(md: &mut String, o: &Outcome) {
-    let (pm, _, _) = mean_check(&o.rows, &o.strategies);
-    if pm.is_empty() {
+    let (pm, _, _) = mean_check(o);
+    if pm.len() < 2 {
         return;
     }
-    let _ = writeln!(md, "## Same expectation?\n\nEvery correct strategy converges to the same image, so their image means must agree within noise (a difference is a bias, not an improvement). Each strategy's image mean at its highest spp, pooled over seeds, with a 95 % interval from its variance images:\n\n| strategy | spp x seeds | mean R | mean G | mean B |\n|---|---|---|---|---|");
+    let _ = writeln!(md, "## Same expectation?\n\nEvery correct strategy converges to the same image, so the image means must agree within noise (a difference is a bias, not an improvement). Each strategy's image mean at its highest spp, pooled over seeds, with a 95 % interval from its variance images (the variance of the mean is dominated by pixels on emitter edges, which the box filter makes noisy):\n\n| image | spp x seeds | mean R | mean G | mean B |\n|---|---|---|---|---|");
     for p in &pm {
         let cell = |c: usize| format!("{:.5e} +- {:.1e}", p.mean[c], 1.959_964 * p.var[c].sqrt());
-        let _ = writeln!(md, "| {} | {} x {} | {} | {} | {} |", p.name, p.spp, p.seeds, cell(0), cell(1), cell(2));
+        let _ = writeln!(
+            md,
+            "| {} | {} x {} | {} | {} | {} |",
+            p.name,
+            p.spp,
+            p.seeds,
+            cell(0),
+            cell(1),
+            cell(2)
+        );
     }
-    let r = o.reference.mean.mean_rgb();
-    let _ = writeln!(md, "| reference | {} | {:.5e} | {:.5e} | {:.5e} |\n", o.reference.info.spp, r[0], r[1], r[2]);
-    for l in mean_check_lines(&o.rows, &o.strategies) {
+    md.push('\n');
+    for l in mean_check_lines(o) {
         let _ = writeln!(md, "- {l}");
     }
     md.push('\n');
@@ -223,7 +319,12 @@ fn means(md: &mut String, o: &Outcome) {
 /// Writes `<dir>/index.md`.
 pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> Result<(), String> {
     let mut md = String::new();
-    let title = o.exp.exp.title.clone().unwrap_or_else(|| o.exp.name.clone());
+    let title = o
+        .exp
+        .exp
+        .title
+        .clone()
+        .unwrap_or_else(|| o.exp.name.clone());
     let _ = writeln!(md, "# {title}\n");
     if !o.exp.exp.description.is_empty() {
         let _ = writeln!(md, "{}\n", o.exp.exp.description.trim());
@@ -238,9 +339,14 @@ pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> R
     for f in figures {
         let _ = writeln!(md, "![{}]({})\n\n{}\n", f.file, f.file, f.caption);
     }
-    let _ = writeln!(md, "Raw numbers: [results.csv](results.csv), one row per render.");
+    let _ = writeln!(
+        md,
+        "Raw numbers: [results.csv](results.csv), one row per render."
+    );
     let path = o.dir.join("index.md");
-    write_atomic(&path, |tmp| std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display())))
+    write_atomic(&path, |tmp| {
+        std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display()))
+    })
 }
 
 /// Writes `<root>/index.md` linking every experiment folder that has a report.
@@ -249,7 +355,9 @@ pub fn write_root_index(root: &Path) -> Result<(), String> {
     if let Ok(rd) = std::fs::read_dir(root) {
         for d in rd.flatten() {
             let idx = d.path().join("index.md");
-            let Ok(text) = std::fs::read_to_string(&idx) else { continue };
+            let Ok(text) = std::fs::read_to_string(&idx) else {
+                continue;
+            };
             let name = d.file_name().to_string_lossy().to_string();
             let title = text
                 .lines()
@@ -261,10 +369,13 @@ pub fn write_root_index(root: &Path) -> Result<(), String> {
         }
     }
     entries.sort();
-    let mut md = String::from("# Experiments\n\nWritten by `directlab run` / `directlab reproduce`.\n\n");
+    let mut md =
+        String::from("# Experiments\n\nWritten by `directlab run` / `directlab reproduce`.\n\n");
     for (name, title) in &entries {
         let _ = writeln!(md, "- [{title}]({name}/index.md)");
     }
     let path = root.join("index.md");
-    write_atomic(&path, |tmp| std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display())))
+    write_atomic(&path, |tmp| {
+        std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display()))
+    })
 }

@@ -254,7 +254,11 @@ mod tests {
 
     #[test]
     fn pooled_mean_uses_the_highest_spp_and_averages_seeds() {
-        let mut rows = vec![test_row("a", 1, 0), test_row("a", 8, 0), test_row("a", 8, 1)];
+        let mut rows = vec![
+            test_row("a", 1, 0),
+            test_row("a", 8, 0),
+            test_row("a", 8, 1),
+        ];
         rows[2].mean_r = 0.3;
         let p = &pooled_means(&rows, &[("a".into(), "A".into())])[0];
         assert_eq!((p.spp, p.seeds), (8, 2));

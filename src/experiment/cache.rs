@@ -78,8 +78,7 @@ pub fn reference_key(k: &KeyInputs) -> Result<String, String> {
     let mut h = Fnv::new();
     h.field(env!("CARGO_PKG_VERSION").as_bytes());
     for f in scene_files(k.scene, k.defines)? {
-        let bytes =
-            std::fs::read(&f).map_err(|e| format!("{}: cannot read: {e}", f.display()))?;
+        let bytes = std::fs::read(&f).map_err(|e| format!("{}: cannot read: {e}", f.display()))?;
         // File names relative to the scene folder would be nicer, but the contents are what
         // matter; the name only guards against two files swapping places.
         h.field(f.file_name().unwrap_or_default().as_encoded_bytes());
@@ -175,6 +174,12 @@ pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, St
             });
         }
     }
+    eprintln!(
+        "rendering the reference ({} at {} spp); it is cached in {} for later runs",
+        req.strategy.label(),
+        req.spp,
+        dir.display()
+    );
     let out = render(
         req.scene,
         req.strategy,

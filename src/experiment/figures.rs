@@ -54,7 +54,10 @@ pub fn charts(o: &Outcome) -> Result<(Vec<Series>, Vec<Figure>), String> {
             title: format!("{what} vs samples per pixel"),
             x_label: "samples per pixel".into(),
             y_label: what.clone(),
-            lines: ss.iter().map(|s| line(s, &|p| (p.spp as f64, p.error))).collect(),
+            lines: ss
+                .iter()
+                .map(|s| line(s, &|p| (p.spp as f64, p.error)))
+                .collect(),
             hline: Some((floor, "reference noise floor".into())),
         },
         format!(
@@ -70,7 +73,10 @@ pub fn charts(o: &Outcome) -> Result<(Vec<Series>, Vec<Figure>), String> {
             title: format!("{what} vs render time"),
             x_label: "render seconds".into(),
             y_label: what.clone(),
-            lines: ss.iter().map(|s| line(s, &|p| (p.seconds, p.error))).collect(),
+            lines: ss
+                .iter()
+                .map(|s| line(s, &|p| (p.seconds, p.error)))
+                .collect(),
             hline: Some((floor, "reference noise floor".into())),
         },
         "Error against render time (the same runs): lower-left is better.".into(),
@@ -117,7 +123,12 @@ fn rel_error_map(img: &Image, r: &Image, eps: f64) -> Vec<f64> {
     img.data
         .iter()
         .zip(&r.data)
-        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).powi(2) / (b[c] * b[c] + eps)).sum::<f64>() / 3.0)
+        .map(|(a, b)| {
+            (0..3)
+                .map(|c| (a[c] - b[c]).powi(2) / (b[c] * b[c] + eps))
+                .sum::<f64>()
+                / 3.0
+        })
         .collect()
 }
 
@@ -170,8 +181,8 @@ fn comparison(
         p.fit(PANEL)
     };
     let r = &o.reference;
-    let mut top = vec![mark(panel_of(&r.mean, exposure, "reference"))
-        .caption(format!("{} spp", r.info.spp))];
+    let mut top =
+        vec![mark(panel_of(&r.mean, exposure, "reference")).caption(format!("{} spp", r.info.spp))];
     let maps: Vec<Vec<f64>> = renders
         .iter()
         .map(|(_, _, img)| rel_error_map(img, &r.mean, eps))
@@ -195,7 +206,9 @@ fn comparison(
             .enlarge(k)];
         row[0].title = format!("{}. {cname}: reference", i + 1);
         for (name, _, img) in &renders {
-            let mut p = panel_of(img, exposure, "").crop(*cx, *cy, *cw, *ch).enlarge(k);
+            let mut p = panel_of(img, exposure, "")
+                .crop(*cx, *cy, *cw, *ch)
+                .enlarge(k);
             p.title = name.clone();
             row.push(p);
         }
@@ -237,7 +250,13 @@ fn variance_maps(o: &Outcome, spp: u32) -> Result<Option<Figure>, String> {
         vars.push(v.iter().map(|x| x * spp as f64).collect::<Vec<f64>>());
         effs.push(
             v.iter()
-                .map(|x| if *x > 0.0 { 1.0 / (x * row.seconds) } else { 0.0 })
+                .map(|x| {
+                    if *x > 0.0 {
+                        1.0 / (x * row.seconds)
+                    } else {
+                        0.0
+                    }
+                })
                 .collect::<Vec<f64>>(),
         );
         names.push(name.clone());

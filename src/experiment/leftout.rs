@@ -46,14 +46,18 @@ fn effective(s: &Strategy, t: &SceneTraits) -> Result<(Strategy, Vec<String>), S
     let mut e = *s;
     let mut why = Vec::new();
     if t.all_bsdfs_delta && e.kind == StrategyKind::Light {
-        return Err("every BSDF is a delta: light samples carry zero throughput, so light \
+        return Err(
+            "every BSDF is a delta: light samples carry zero throughput, so light \
                     sampling shows only directly visible emitters"
-            .into());
+                .into(),
+        );
     }
     if t.all_lights_delta && e.kind == StrategyKind::Bsdf {
-        return Err("every light is a delta (point light): BSDF samples never hit one, so the \
+        return Err(
+            "every light is a delta (point light): BSDF samples never hit one, so the \
                     image would be black"
-            .into());
+                .into(),
+        );
     }
     if t.all_bsdfs_delta && matches!(e.kind, StrategyKind::Mis | StrategyKind::MisOneSample) {
         e.kind = StrategyKind::Bsdf;
@@ -136,10 +140,7 @@ pub fn leave_out(
             }
         }
     }
-    (
-        kept.into_iter().map(|(n, s, _)| (n, s)).collect(),
-        omitted,
-    )
+    (kept.into_iter().map(|(n, s, _)| (n, s)).collect(), omitted)
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(),
     let (series, mut figs) = figures::charts(&o)?;
     figs.extend(figures::images(&o)?);
     crate::report::write_experiment(&o, &series, &figs)?;
-    for l in crate::report::mean_check_lines(&o.rows, &o.strategies) {
+    for l in crate::report::mean_check_lines(&o) {
         println!("{}: {l}", o.exp.name);
     }
     println!(

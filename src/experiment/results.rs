@@ -78,7 +78,8 @@ impl Results {
                 dropped: 0,
             });
         }
-        let mut rd = csv::Reader::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut rd =
+            csv::Reader::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let mut rows = Vec::new();
         let mut dropped = 0;
         for r in rd.deserialize::<Row>() {
@@ -177,7 +178,10 @@ mod tests {
         assert_eq!(back.rows[0], test_row("light", 4, 0));
         assert!(back.find_sweep("light", 4, 0).is_some());
         assert!(back.find_sweep("light", 4, 1).is_none());
-        assert!(back.find_sweep("mis", 16, 0).is_none(), "equal-time is not a sweep row");
+        assert!(
+            back.find_sweep("mis", 16, 0).is_none(),
+            "equal-time is not a sweep row"
+        );
         assert_eq!(back.find_equal_time("mis", 0.25, 0), Some(&t));
         assert!(back.find_equal_time("mis", 0.5, 0).is_none());
         let header = std::fs::read_to_string(&path).unwrap();

@@ -196,7 +196,10 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
         .collect();
     let (kept, omitted) = leave_out(&listed, &SceneTraits::of(&scene));
     for o in &omitted {
-        eprintln!("{}: leaving out '{}' ({}): {}", exp.name, o.name, o.label, o.reason);
+        eprintln!(
+            "{}: leaving out '{}' ({}): {}",
+            exp.name, o.name, o.label, o.reason
+        );
     }
 
     let x = &exp.exp;
@@ -230,7 +233,11 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
         exp.name,
         ri.strategy,
         ri.spp,
-        if reference.cached { "cached" } else { "rendered now" },
+        if reference.cached {
+            "cached"
+        } else {
+            "rendered now"
+        },
         ri.seconds,
         ri.mse_floor,
         ri.relmse_floor

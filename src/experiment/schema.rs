@@ -347,7 +347,10 @@ mod tests {
     fn parses_the_example_and_applies_quick() {
         let exp = parse(EXAMPLE, &file()).unwrap();
         assert_eq!(exp.strategies.len(), 2);
-        assert!(matches!(exp.strategies[0].strategy, Some(StrategyArg::Light)));
+        assert!(matches!(
+            exp.strategies[0].strategy,
+            Some(StrategyArg::Light)
+        ));
         assert!(matches!(
             exp.strategies[0].light_sampling,
             Some(LightSamplingArg::SolidAngle)
@@ -364,7 +367,10 @@ mod tests {
 
         let full = resolve(exp.clone(), &file(), false).unwrap();
         assert_eq!(full.name, "demo");
-        assert_eq!(full.scene, PathBuf::from("experiments/../scenes/cbox/cbox.xml"));
+        assert_eq!(
+            full.scene,
+            PathBuf::from("experiments/../scenes/cbox/cbox.xml")
+        );
         assert_eq!(full.defines, vec![("res".into(), "64".into())]);
         assert_eq!(full.equal_spp(), 4);
 

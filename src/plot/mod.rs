@@ -61,7 +61,9 @@ pub struct LogLogChart {
 fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite() && *v > 0.0)
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
     if !lo.is_finite() {
         return (0.1, 10.0);
     }
@@ -104,6 +106,8 @@ where
         .x_desc(&c.x_label)
         .y_desc(&c.y_label)
         .label_style((FONT, 13))
+        .light_line_style(RGBColor(240, 240, 240))
+        .bold_line_style(RGBColor(200, 200, 200))
         .axis_desc_style((FONT, 15))
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .x_label_formatter(&|v| format!("{v}"))
