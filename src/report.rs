@@ -2,10 +2,12 @@
 //! what was left out and why, tables, figures) and `reports/index.md` linking them all.
 
 use crate::experiment::analysis::{
-    error_of, mean_difference, metric_name, pooled_means, MeanDiff, PooledMean, Series,
+    error_of, mean_difference, metric_name, pooled_means, predicted_of, MeanDiff, PooledMean,
+    Series,
 };
 use crate::experiment::figures::Figure;
 use crate::experiment::results::{Row, EQUAL_TIME};
+use crate::experiment::schema::ErrorMetric;
 use crate::experiment::Outcome;
 use crate::film::write_atomic;
 use crate::stats::sidak;
@@ -239,6 +241,57 @@ fn error_table(md: &mut String, o: &Outcome, series: &[Series]) {
     md.push('\n');
 }
 
+/// Reads each curve: does it fall as 1/N, and do run and reference agree pixel by pixel? The
+/// verdicts are rules of thumb, stated as such in the report.
+fn diagnostics(md: &mut String, o: &Outcome, series: &[Series]) {
+    let m = o.exp.exp.metrics.primary;
+    let mse_series = crate::experiment::analysis::series(&o.rows, &o.strategies, ErrorMetric::Mse);
+    let _ = writeln!(md, "## Reading the curves\n\nFor an unbiased estimator with finite variance, N x error is constant, the measured error matches the one the run's own variance images predict (`*_predicted` in the CSV), and the per-pixel z^2 = (x - r)^2 / (var_x + var_r) averages about 1. Rules of thumb used below: mean z^2 and measured / predicted both above 1.5 at the highest spp suggest a **bias** (z^2 alone also rises for rare-event estimators, whose pixels without a hit report zero variance); a slope within 0.15 of -1 is 1/N convergence; a shallow relMSE slope with a 1/N MSE slope means a few high-weight pixels (dark pixels next to emitter edges) dominate relMSE; a shallow slope in both means a heavy-tailed estimator whose rare large samples (fireflies) are not yet drawn at low spp, so its error and its variance estimates are both too low there.\n\n| strategy | slope | slope (MSE) | N x error, lowest spp | N x error, highest spp | measured / predicted | mean z^2 | reading |\n|---|---|---|---|---|---|---|---|");
+    for (s, sm) in series.iter().zip(&mse_series) {
+        let (Some(first), Some(last)) = (s.points.first(), s.points.last()) else {
+            continue;
+        };
+        let rows: Vec<&Row> = o
+            .rows
+            .iter()
+            .filter(|r| r.is_sweep() && r.strategy == s.label && r.spp == last.spp)
+            .collect();
+        let n = rows.len().max(1) as f64;
+        let pred = rows.iter().map(|r| predicted_of(r, m)).sum::<f64>() / n;
+        let ratio = if pred > 0.0 {
+            last.error / pred
+        } else {
+            f64::NAN
+        };
+        let z2 = rows.iter().map(|r| r.mean_z2).sum::<f64>() / n;
+        let near = |k: Option<f64>| k.is_some_and(|k| (k + 1.0).abs() <= 0.15);
+        let reading = match s.slope {
+            // z^2 alone also rises for rare-event estimators (a pixel with no hit yet reports
+            // zero variance), so a bias needs the error above its prediction as well.
+            _ if z2 > 1.5 && ratio > 1.5 && last.spp >= 16 => {
+                "**bias?** error above its variance, pixels beyond their noise".to_string()
+            }
+            None => "too few points".into(),
+            k if near(k) => "converges as 1/N".into(),
+            _ if near(sm.slope) => "1/N in MSE; relMSE dominated by a few pixels".into(),
+            Some(k) if k > -0.85 => "heavy-tailed: not yet in the 1/N regime".into(),
+            Some(_) => "steeper than 1/N (noisy curve)".into(),
+        };
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {:.2} | {:.3} | {reading} |",
+            s.name,
+            s.slope.map_or("-".into(), |k| format!("{k:.2}")),
+            sm.slope.map_or("-".into(), |k| format!("{k:.2}")),
+            e(first.error * first.spp as f64),
+            e(last.error * last.spp as f64),
+            ratio,
+            z2
+        );
+    }
+    md.push('\n');
+}
+
 fn equal_time_table(md: &mut String, o: &Outcome) {
     let rows: Vec<&Row> = o.rows.iter().filter(|r| r.kind == EQUAL_TIME).collect();
     if rows.is_empty() {
@@ -263,7 +316,7 @@ fn equal_time_table(md: &mut String, o: &Outcome) {
 }
 
 fn variance_table(md: &mut String, o: &Outcome) {
-    let spp = o.exp.equal_spp();
+    let spp = o.exp.variance_spp();
     let _ = writeln!(md, "## Variance of the image mean at {spp} spp\n\nFrom the per-pixel variance images (pixels are independent, so Var(image mean) = sum of pixel variances / pixels^2), averaged over seeds; x spp gives the per-sample value, x seconds the cost-weighted value (lower is better).\n\n| strategy | Var R | Var G | Var B | Var G x spp | Var G x seconds |\n|---|---|---|---|---|---|");
     for (label, name) in &o.strategies {
         let rs: Vec<&Row> = o
@@ -332,6 +385,7 @@ pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> R
     settings(&mut md, o);
     left_out(&mut md, o);
     error_table(&mut md, o, series);
+    diagnostics(&mut md, o, series);
     equal_time_table(&mut md, o);
     means(&mut md, o);
     variance_table(&mut md, o);

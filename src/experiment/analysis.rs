@@ -13,6 +13,22 @@ pub fn error_of(r: &Row, m: ErrorMetric) -> f64 {
     }
 }
 
+/// The error a row's own variance image predicts for an unbiased estimator.
+pub fn predicted_of(r: &Row, m: ErrorMetric) -> f64 {
+    match m {
+        ErrorMetric::Mse => r.mse_predicted,
+        ErrorMetric::Relmse => r.relmse_predicted,
+    }
+}
+
+/// Short name for captions; figure titles state epsilon.
+pub fn metric_short(m: ErrorMetric) -> &'static str {
+    match m {
+        ErrorMetric::Mse => "MSE",
+        ErrorMetric::Relmse => "relMSE",
+    }
+}
+
 pub fn metric_name(m: ErrorMetric, eps: f64) -> String {
     match m {
         ErrorMetric::Mse => "MSE".into(),

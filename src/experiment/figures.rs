@@ -1,7 +1,7 @@
 //! The figures of one experiment: convergence charts and image comparisons, written beside
 //! its report. Returns what the report lists.
 
-use super::analysis::{error_of, metric_name, series, Series};
+use super::analysis::{error_of, metric_name, metric_short, series, Series};
 use super::results::{Results, Row};
 use super::runner::{image_path, load_image, spp_tag, time_tag, Outcome};
 use crate::film::{to_srgb8, Image};
@@ -191,9 +191,10 @@ fn comparison(
     let mut second = vec![colour_bar(&format!("per-pixel relMSE (eps {eps})"), &scale)];
     for ((name, row, img), map) in renders.iter().zip(&maps) {
         top.push(mark(panel_of(img, exposure, name)).caption(format!(
-            "{} spp, {:.2} s, {what} {}",
+            "{} spp, {:.2} s, {} {}",
             row.spp,
             row.seconds,
+            metric_short(m),
             short(error_of(row, m))
         )));
         second.push(map_panel(map, o.width, o.height, &scale, name).fit(PANEL));
@@ -214,7 +215,7 @@ fn comparison(
         }
         rows.push(row);
     }
-    write_figure(&o.dir.join(file), title, &rows)?;
+    write_figure(&o.dir.join(file), &format!("{title} ({what})"), &rows)?;
     Ok(Some(Figure {
         file: file.into(),
         caption: format!(
@@ -309,7 +310,7 @@ fn progression(o: &Outcome) -> Result<Option<Figure>, String> {
         rows: o.rows.clone(),
         dropped: 0,
     };
-    let target = (1200 / (spps.len() as u32 + 1)).clamp(96, PANEL);
+    let target = (1800 / (spps.len() as u32 + 1)).clamp(96, PANEL);
     let mut rows = Vec::new();
     for (label, name) in &o.strategies {
         let mut row = Vec::new();
@@ -321,7 +322,7 @@ fn progression(o: &Outcome) -> Result<Option<Figure>, String> {
             row.push(
                 panel_of(&img, exposure, &format!("{name}, {spp} spp"))
                     .fit(target)
-                    .caption(format!("{what} {}", short(error_of(r, m)))),
+                    .caption(format!("{} {}", metric_short(m), short(error_of(r, m)))),
             );
         }
         row.push(
@@ -332,7 +333,11 @@ fn progression(o: &Outcome) -> Result<Option<Figure>, String> {
         rows.push(row);
     }
     let file = "progression.png";
-    write_figure(&o.dir.join(file), "Convergence to the reference", &rows)?;
+    write_figure(
+        &o.dir.join(file),
+        &format!("Convergence to the reference ({what}, seed 0)"),
+        &rows,
+    )?;
     Ok(Some(Figure {
         file: file.into(),
         caption: format!(
@@ -368,6 +373,6 @@ pub fn images(o: &Outcome) -> Result<Vec<Figure>, String> {
             )?);
         }
     }
-    figs.extend(variance_maps(o, spp)?);
+    figs.extend(variance_maps(o, o.exp.variance_spp())?);
     Ok(figs)
 }

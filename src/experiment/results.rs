@@ -36,6 +36,13 @@ pub struct Row {
     /// MSE this run's own variance image predicts (mean variance of its pixel means); for an
     /// unbiased estimator E[mse_corrected] equals it. Zero at 1 spp (no variance estimate).
     pub mse_predicted: f64,
+    /// The same for relMSE: mean of variance / (r^2 + eps). A measured relMSE far below it at
+    /// low spp points to a heavy-tailed estimator (rare large samples not yet drawn).
+    pub relmse_predicted: f64,
+    /// Mean over pixels and channels of (x - r)^2 / (var_x + var_r): about 1 when run and
+    /// reference have the same expectation (above 1 by (n-1)/(n-3) at small spp n, from the
+    /// estimated variances). Well above 1 at high spp means a bias. NaN at 1 spp.
+    pub mean_z2: f64,
     pub mean_r: f64,
     pub mean_g: f64,
     pub mean_b: f64,
@@ -142,6 +149,8 @@ pub(crate) fn test_row(strategy: &str, spp: u32, seed: u64) -> Row {
         relmse_corrected: 0.5 / spp as f64,
         relmse_eps: 0.01,
         mse_predicted: 0.0,
+        relmse_predicted: 0.0,
+        mean_z2: 1.0,
         mean_r: 0.1,
         mean_g: 0.2,
         mean_b: 0.3,

@@ -86,9 +86,27 @@ fn measure(ctx: &Ctx, job: &Job, out: &RenderOutput) -> Row {
     let relmse = metrics::rel_mse(&out.mean, &r.mean, ctx.eps);
     let n = out.mean.data.len() as f64;
     let mut var_sum = [0.0f64; 3];
-    for v in &out.variance.data {
+    let mut rel_var = 0.0f64;
+    let (mut z2, mut z2_n) = (0.0f64, 0u64);
+    for (((v, m), x), rv) in out
+        .variance
+        .data
+        .iter()
+        .zip(&r.mean.data)
+        .zip(&out.mean.data)
+        .zip(&r.variance.data)
+    {
         for c in 0..3 {
             var_sum[c] += v[c];
+            rel_var += v[c] / (m[c] * m[c] + ctx.eps);
+            // Pixels where neither image varies (background, emitter interiors) carry no
+            // information; the cached reference is stored in f32, so its rounding (relative
+            // 6e-8) is part of the noise, or exact pixels would give z^2 = 1e40.
+            let var = v[c] + rv[c] + (1e-7 * m[c].abs().max(x[c].abs())).powi(2);
+            if out.spp > 1 && v[c] + rv[c] > 0.0 {
+                z2 += (x[c] - m[c]).powi(2) / var;
+                z2_n += 1;
+            }
         }
     }
     let mean = out.mean.mean_rgb();
@@ -110,6 +128,8 @@ fn measure(ctx: &Ctx, job: &Job, out: &RenderOutput) -> Row {
         relmse_corrected: relmse - r.info.relmse_floor,
         relmse_eps: ctx.eps,
         mse_predicted: var_sum.iter().sum::<f64>() / (3.0 * n),
+        relmse_predicted: rel_var / (3.0 * n),
+        mean_z2: if z2_n > 0 { z2 / z2_n as f64 } else { f64::NAN },
         mean_r: mean[0],
         mean_g: mean[1],
         mean_b: mean[2],
@@ -170,6 +190,41 @@ fn progress_bar(total_samples: u64, runs: usize) -> ProgressBar {
     );
     b.set_message(format!("0/{runs} runs"));
     b
+}
+
+/// What the sweep covers, and which seed-0 images the figures need.
+struct Sweep<'a> {
+    spp: &'a [u32],
+    seeds: u32,
+    keep_spp: &'a [u32],
+    dir: &'a Path,
+}
+
+/// The sweep's renders still to do: rows missing from `results`, and rows whose image the
+/// figures need but which is missing (seeds give the same image again, so the row is redone).
+fn plan_sweep(results: &Results, kept: &[(String, Strategy)], sw: &Sweep) -> Vec<Job> {
+    let mut jobs = Vec::new();
+    for seed in 0..sw.seeds as u64 {
+        for &spp in sw.spp {
+            for (name, s) in kept {
+                let image = (seed == 0 && sw.keep_spp.contains(&spp))
+                    .then(|| image_path(sw.dir, &s.label(), &spp_tag(spp), seed));
+                let done = results.find_sweep(&s.label(), spp, seed).is_some();
+                if !done || !has_image(&image) {
+                    jobs.push(Job {
+                        name: name.clone(),
+                        strategy: *s,
+                        kind: SWEEP,
+                        budget: 0.0,
+                        spp,
+                        seed,
+                        image,
+                    });
+                }
+            }
+        }
+    }
+    jobs
 }
 
 /// Samples per second of a strategy over its sweep rows (dominated by the long runs, where
@@ -264,27 +319,17 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
     let pixels = scene.camera.width as u64 * scene.camera.height as u64;
     let mut keep_spp: Vec<u32> = x.figures.progression.clone();
     keep_spp.push(exp.equal_spp());
-    let mut jobs = Vec::new();
-    for seed in 0..x.seeds as u64 {
-        for &spp in &x.spp {
-            for (name, s) in &kept {
-                let image = (seed == 0 && keep_spp.contains(&spp))
-                    .then(|| image_path(&dir, &s.label(), &spp_tag(spp), seed));
-                let done = results.find_sweep(&s.label(), spp, seed).is_some();
-                if !done || !has_image(&image) {
-                    jobs.push(Job {
-                        name: name.clone(),
-                        strategy: *s,
-                        kind: SWEEP,
-                        budget: 0.0,
-                        spp,
-                        seed,
-                        image,
-                    });
-                }
-            }
-        }
-    }
+    keep_spp.push(exp.variance_spp());
+    let jobs = plan_sweep(
+        &results,
+        &kept,
+        &Sweep {
+            spp: &x.spp,
+            seeds: x.seeds,
+            keep_spp: &keep_spp,
+            dir: &dir,
+        },
+    );
     let equal_time_runs = x
         .equal_time
         .as_ref()
@@ -378,4 +423,59 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
 /// Loads a kept image and its variance.
 pub fn load_image(p: &Path) -> Result<(Image, Image), String> {
     Ok((film::read_exr(p)?, film::read_exr(&variance_path(p))?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::results::test_row;
+    use crate::scene::desc::{Heuristic, StrategyKind};
+
+    #[test]
+    fn resume_plans_only_missing_rows_and_missing_images() {
+        let dir = std::env::temp_dir().join(format!("directlab-plan-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let s = Strategy {
+            kind: StrategyKind::Light,
+            heuristic: Heuristic::Balance,
+            emitter_samples: 1,
+            bsdf_samples: 1,
+            selection: crate::emitter::EmitterSelection::Uniform,
+            light_sampling: crate::emitter::LightSampling::Area,
+            hide_emitters: false,
+        };
+        let label = s.label();
+        let kept = vec![("light".to_string(), s)];
+        let sw = Sweep {
+            spp: &[1, 4],
+            seeds: 2,
+            keep_spp: &[4],
+            dir: &dir,
+        };
+        let planned = |res: &Results| -> Vec<(u32, u64)> {
+            plan_sweep(res, &kept, &sw)
+                .iter()
+                .map(|j| (j.spp, j.seed))
+                .collect()
+        };
+        let mut res = Results {
+            rows: vec![],
+            dropped: 0,
+        };
+        assert_eq!(planned(&res), [(1, 0), (4, 0), (1, 1), (4, 1)]);
+        res.rows = [(1, 0), (4, 0), (4, 1)]
+            .iter()
+            .map(|&(spp, seed)| test_row(&label, spp, seed))
+            .collect();
+        // (4, 0) is done but the figures need its image, which is not there yet.
+        assert_eq!(planned(&res), [(4, 0), (1, 1)]);
+        let img = image_path(&dir, &label, &spp_tag(4), 0);
+        std::fs::create_dir_all(img.parent().unwrap()).unwrap();
+        std::fs::write(&img, "").unwrap();
+        std::fs::write(variance_path(&img), "").unwrap();
+        assert_eq!(planned(&res), [(1, 1)]);
+        res.rows.push(test_row(&label, 1, 1));
+        assert!(planned(&res).is_empty());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -153,8 +153,11 @@ pub struct Crop {
 #[derive(Clone, Debug, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct FiguresSpec {
-    /// spp of the side-by-side comparison and the variance maps (default: the median sweep spp).
+    /// spp of the side-by-side comparison (default: the middle sweep spp).
     pub equal_spp: Option<u32>,
+    /// spp of the variance and efficiency maps (default: the highest sweep spp, where the
+    /// per-pixel variance estimates are least noisy).
+    pub variance_spp: Option<u32>,
     /// spp values shown as an image row per strategy, each with its error printed under it.
     #[serde(default)]
     pub progression: Vec<u32>,
@@ -196,6 +199,13 @@ impl Resolved {
             .equal_spp
             .unwrap_or(self.exp.spp[self.exp.spp.len() / 2])
     }
+
+    pub fn variance_spp(&self) -> u32 {
+        self.exp
+            .figures
+            .variance_spp
+            .unwrap_or_else(|| *self.exp.spp.iter().max().expect("validated non-empty"))
+    }
 }
 
 pub fn parse(text: &str, file: &Path) -> Result<Experiment, String> {
@@ -233,6 +243,8 @@ pub fn resolve(mut exp: Experiment, file: &Path, quick: bool) -> Result<Resolved
         if q.equal_spp.is_some() {
             exp.figures.equal_spp = q.equal_spp;
         }
+        // The full run's variance spp is rarely in the quick sweep: use the quick maximum.
+        exp.figures.variance_spp = None;
         if let Some(p) = q.progression {
             exp.figures.progression = p;
         }
@@ -263,6 +275,17 @@ fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
     }
     if exp.seeds == 0 {
         return fail("`seeds` must be at least 1".into());
+    }
+    for (what, v) in [
+        ("figures.equal_spp", exp.figures.equal_spp),
+        ("figures.variance_spp", exp.figures.variance_spp),
+    ] {
+        if let Some(v) = v.filter(|v| !exp.spp.contains(v)) {
+            return fail(format!(
+                "{what} = {v} is not one of the sweep's spp {:?}",
+                exp.spp
+            ));
+        }
     }
     if exp.strategies.is_empty() {
         return fail("at least one [[strategy]] is needed".into());
@@ -373,6 +396,7 @@ mod tests {
         );
         assert_eq!(full.defines, vec![("res".into(), "64".into())]);
         assert_eq!(full.equal_spp(), 4);
+        assert_eq!(full.variance_spp(), 16);
 
         let quick = resolve(exp, &file(), true).unwrap();
         assert_eq!(quick.name, "demo-quick");
@@ -393,6 +417,9 @@ mod tests {
         let shared_seed = EXAMPLE.replace("spp = 256", "spp = 256\nseed = 1");
         let e = resolve(parse(&shared_seed, &file()).unwrap(), &file(), false).unwrap_err();
         assert!(e.contains("independent"), "{e}");
+        let off = EXAMPLE.replace("[figures]", "[figures]\nequal_spp = 8");
+        let e = resolve(parse(&off, &file()).unwrap(), &file(), false).unwrap_err();
+        assert!(e.contains("equal_spp = 8 is not one of"), "{e}");
         let crop = EXAMPLE.replace("width = 0.25", "width = 1.25");
         let e = resolve(parse(&crop, &file()).unwrap(), &file(), false).unwrap_err();
         assert!(e.contains("crop"), "{e}");

@@ -24,6 +24,9 @@ pub fn viridis(t: f64) -> [u8; 3] {
     [0, 1, 2].map(|c| (a[c] + (b[c] - a[c]) * f).round() as u8)
 }
 
+/// Widest range a colour scale spans, in powers of ten.
+pub const DECADES: i32 = 5;
+
 /// A log10 colour scale shared by several maps so they can be compared.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LogScale {
@@ -33,7 +36,8 @@ pub struct LogScale {
 
 impl LogScale {
     /// From the 1st and 99th percentiles of the positive values, so a few outliers do not
-    /// wash out the map; a scale spanning less than a factor 10 is widened to 10.
+    /// wash out the map; at most `DECADES` decades (pixels that are exact up to rounding would
+    /// otherwise stretch the scale to 1e-50), at least one.
     pub fn from_values(values: impl Iterator<Item = f64>) -> LogScale {
         let mut v: Vec<f64> = values.filter(|x| x.is_finite() && *x > 0.0).collect();
         if v.is_empty() {
@@ -42,6 +46,7 @@ impl LogScale {
         v.sort_by(f64::total_cmp);
         let at = |q: f64| v[((v.len() - 1) as f64 * q) as usize];
         let (mut lo, mut hi) = (at(0.01), at(0.99));
+        lo = lo.max(hi * 10f64.powi(-DECADES));
         if hi < 10.0 * lo {
             let mid = (lo * hi).sqrt();
             lo = mid / 10f64.sqrt();
@@ -85,5 +90,10 @@ mod tests {
         assert_eq!(s.t(s.lo), 0.0);
         assert!((s.t(s.hi) - 1.0).abs() < 1e-12);
         assert_eq!(s.t(0.0), 0.0);
+        // Rounding-level values (many exact pixels) must not stretch the scale.
+        let mut v: Vec<f64> = (0..500).map(|_| 1e-50).collect();
+        v.extend((1..=500).map(|i| i as f64));
+        let s = LogScale::from_values(v.into_iter());
+        assert!((s.lo - s.hi * 1e-5).abs() < 1e-12 * s.hi, "{s:?}");
     }
 }
