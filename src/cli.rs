@@ -25,6 +25,10 @@ pub struct Cli {
 pub enum Command {
     /// Render a Mitsuba 3, Mitsuba 0.6 or Nori XML scene to EXR (plus an sRGB PNG preview).
     Render(RenderArgs),
+    /// Run experiments (sweeps against a cached reference) and write their reports.
+    Run(RunArgs),
+    /// Run the study's figures (experiments fig1, fig2, fig3) and write their reports.
+    Reproduce(ReproduceArgs),
     /// Measure render throughput per strategy and thread count.
     Bench(crate::bench::BenchArgs),
     /// Chi-square tests of every sampling routine against its pdf (warps, BSDFs, emitters),
@@ -32,7 +36,92 @@ pub enum Command {
     Chi2(crate::chi2cases::command::Chi2Args),
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+/// Options shared by `run` and `reproduce`.
+#[derive(Args, Debug, Clone)]
+pub struct SweepArgs {
+    /// Small resolution and spp from each file's [quick] table (tests, smoke runs); written
+    /// to `<name>-quick`.
+    #[arg(long)]
+    pub quick: bool,
+    /// Reports folder; each experiment writes into `<out>/<name>/`.
+    #[arg(long, default_value = "reports")]
+    pub out: PathBuf,
+    /// Worker threads (default: all cores). Images do not depend on it; timings do.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Render the references again even if the cache has them (after changing the renderer).
+    #[arg(long)]
+    pub fresh_reference: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Experiment files (TOML).
+    #[arg(required_unless_present = "all")]
+    pub experiments: Vec<PathBuf>,
+    /// Run every experiments/*.toml.
+    #[arg(long, conflicts_with = "experiments")]
+    pub all: bool,
+    #[command(flatten)]
+    pub sweep: SweepArgs,
+}
+
+#[derive(Args, Debug)]
+pub struct ReproduceArgs {
+    #[command(flatten)]
+    pub sweep: SweepArgs,
+}
+
+fn run_files(files: &[PathBuf], a: &SweepArgs) -> Result<(), String> {
+    use crate::experiment::{run_and_report, RunOptions};
+    let opts = RunOptions {
+        out: a.out.clone(),
+        threads: a.threads,
+        fresh_reference: a.fresh_reference,
+    };
+    let start = std::time::Instant::now();
+    let mut failed = Vec::new();
+    for f in files {
+        // One failing experiment should not cost the others their results.
+        if let Err(e) = run_and_report(f, a.quick, &opts) {
+            eprintln!("error: {}: {e}", f.display());
+            failed.push(f.display().to_string());
+        }
+    }
+    crate::report::write_root_index(&a.out)?;
+    eprintln!(
+        "{} experiment(s) in {:.1} s; reports in {}",
+        files.len(),
+        start.elapsed().as_secs_f64(),
+        a.out.join("index.md").display()
+    );
+    if failed.is_empty() {
+        Ok(())
+    } else {
+        Err(format!("failed: {}", failed.join(", ")))
+    }
+}
+
+fn cmd_run(a: &RunArgs) -> Result<(), String> {
+    let files = if a.all {
+        crate::experiment::all_experiments()?
+    } else {
+        a.experiments.clone()
+    };
+    run_files(&files, &a.sweep)
+}
+
+fn cmd_reproduce(a: &ReproduceArgs) -> Result<(), String> {
+    let dir = crate::experiment::experiments_dir()?;
+    let files: Vec<PathBuf> = ["fig1", "fig2", "fig3"]
+        .iter()
+        .map(|n| dir.join(format!("{n}.toml")))
+        .collect();
+    run_files(&files, &a.sweep)
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum StrategyArg {
     Bsdf,
     Light,
@@ -40,26 +129,31 @@ pub enum StrategyArg {
     MisOnesample,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum SelectionArg {
     Uniform,
     Power,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum LightSamplingArg {
     Area,
     SolidAngle,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum HeuristicArg {
     Balance,
     Power,
 }
 
-/// Estimator choices; anything not given keeps the scene's own integrator settings.
-#[derive(Args, Debug, Clone, Default)]
+/// Estimator choices; anything not given keeps the scene's own integrator settings. Experiment
+/// files use the same names (`strategy = "mis"`, `emitter_selection = "power"`, ...).
+#[derive(Args, Debug, Clone, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct StrategyArgs {
     #[arg(long, value_enum)]
     pub strategy: Option<StrategyArg>,
@@ -248,6 +342,8 @@ pub fn main() -> i32 {
     let cli = Cli::parse();
     let r = match &cli.command {
         Command::Render(a) => cmd_render(a),
+        Command::Run(a) => cmd_run(a),
+        Command::Reproduce(a) => cmd_reproduce(a),
         Command::Bench(a) => crate::bench::run(a),
         Command::Chi2(a) => crate::chi2cases::command::run(a).and_then(|ok| {
             ok.then_some(())

@@ -1,0 +1,297 @@
+//! Reference images: rendered once at high spp and cached under a key that changes whenever
+//! anything that could change the image changes: the scene file and every file it references
+//! (meshes), the `-D` overrides, the reference's spp, seed and estimator, and the crate version.
+//!
+//! The key does not see edits to the renderer that keep the crate version; `--fresh-reference`
+//! re-renders after such a change.
+
+use crate::film::{self, Image};
+use crate::integrator::Strategy;
+use crate::render::{render, RenderSettings};
+use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// FNV-1a, 64 bit: stable across Rust versions and platforms, unlike `DefaultHasher`.
+pub struct Fnv(u64);
+
+impl Fnv {
+    pub fn new() -> Self {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+
+    pub fn bytes(&mut self, b: &[u8]) -> &mut Self {
+        for &x in b {
+            self.0 ^= x as u64;
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        self
+    }
+
+    /// Length-prefixed, so ("ab", "c") and ("a", "bc") hash differently.
+    pub fn field(&mut self, b: &[u8]) -> &mut Self {
+        self.bytes(&(b.len() as u64).to_le_bytes()).bytes(b)
+    }
+
+    pub fn hex(&self) -> String {
+        format!("{:016x}", self.0)
+    }
+}
+
+impl Default for Fnv {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// The scene file and the files it names through `filename` parameters (after `$name`
+/// substitution with the defines), in document order.
+pub fn scene_files(scene: &Path, defines: &[(String, String)]) -> Result<Vec<PathBuf>, String> {
+    let xml = std::fs::read_to_string(scene)
+        .map_err(|e| format!("{}: cannot read scene: {e}", scene.display()))?;
+    let root =
+        crate::scene::xml::parse_document(&xml, scene, defines).map_err(|e| e.to_string())?;
+    let dir = scene.parent().unwrap_or(Path::new("."));
+    let mut files = vec![scene.to_path_buf()];
+    let mut stack = vec![&root];
+    while let Some(e) = stack.pop() {
+        if e.attr("name") == Some("filename") {
+            if let Some(v) = e.attr("value") {
+                files.push(dir.join(v));
+            }
+        }
+        stack.extend(e.children.iter().rev());
+    }
+    Ok(files)
+}
+
+/// Everything the reference image depends on.
+pub struct KeyInputs<'a> {
+    pub scene: &'a Path,
+    pub defines: &'a [(String, String)],
+    pub spp: u32,
+    pub seed: u64,
+    pub strategy: &'a Strategy,
+}
+
+pub fn reference_key(k: &KeyInputs) -> Result<String, String> {
+    let mut h = Fnv::new();
+    h.field(env!("CARGO_PKG_VERSION").as_bytes());
+    for f in scene_files(k.scene, k.defines)? {
+        let bytes = std::fs::read(&f).map_err(|e| format!("{}: cannot read: {e}", f.display()))?;
+        // File names relative to the scene folder would be nicer, but the contents are what
+        // matter; the name only guards against two files swapping places.
+        h.field(f.file_name().unwrap_or_default().as_encoded_bytes());
+        h.field(&bytes);
+    }
+    let mut defines = k.defines.to_vec();
+    defines.sort();
+    for (n, v) in &defines {
+        h.field(n.as_bytes()).field(v.as_bytes());
+    }
+    h.field(&k.spp.to_le_bytes()).field(&k.seed.to_le_bytes());
+    h.field(format!("{:?}", k.strategy).as_bytes());
+    Ok(h.hex())
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ReferenceInfo {
+    pub key: String,
+    pub strategy: String,
+    pub spp: u32,
+    pub seed: u64,
+    pub seconds: f64,
+    pub non_finite_samples: u64,
+    /// mean over pixels and channels of the reference's variance image: the expected MSE
+    /// between the reference and the true image, added to every measured MSE.
+    pub mse_floor: f64,
+    /// The same for relMSE (each pixel's variance divided by r^2 + epsilon).
+    pub relmse_floor: f64,
+    pub relmse_epsilon: f64,
+}
+
+pub struct Reference {
+    pub mean: Image,
+    pub variance: Image,
+    pub info: ReferenceInfo,
+    /// True if it came from the cache.
+    pub cached: bool,
+}
+
+/// Noise floors of a reference with per-pixel variance-of-mean `var`.
+pub fn noise_floor(mean: &Image, var: &Image, eps: f64) -> (f64, f64) {
+    let (mut m, mut r) = (0.0f64, 0.0f64);
+    for (p, v) in mean.data.iter().zip(&var.data) {
+        for c in 0..3 {
+            m += v[c];
+            r += v[c] / (p[c] * p[c] + eps);
+        }
+    }
+    let n = 3.0 * mean.data.len().max(1) as f64;
+    (m / n, r / n)
+}
+
+fn paths(dir: &Path, key: &str) -> (PathBuf, PathBuf, PathBuf) {
+    (
+        dir.join(format!("reference-{key}.exr")),
+        dir.join(format!("reference-{key}-var.exr")),
+        dir.join(format!("reference-{key}.json")),
+    )
+}
+
+fn load(dir: &Path, key: &str) -> Option<(Image, Image, ReferenceInfo)> {
+    let (m, v, j) = paths(dir, key);
+    let info: ReferenceInfo = serde_json::from_str(&std::fs::read_to_string(j).ok()?).ok()?;
+    Some((film::read_exr(&m).ok()?, film::read_exr(&v).ok()?, info))
+}
+
+pub struct ReferenceRequest<'a> {
+    pub scene: &'a Scene,
+    pub key: String,
+    pub strategy: Strategy,
+    pub spp: u32,
+    pub seed: u64,
+    pub threads: Option<usize>,
+    pub relmse_epsilon: f64,
+    pub fresh: bool,
+    pub progress: bool,
+}
+
+/// The cached reference for `req.key`, or a new render stored under it.
+pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, String> {
+    if !req.fresh {
+        if let Some((mean, variance, mut info)) = load(dir, &req.key) {
+            // The floor depends on epsilon, which is not part of the key.
+            let (m, r) = noise_floor(&mean, &variance, req.relmse_epsilon);
+            info.mse_floor = m;
+            info.relmse_floor = r;
+            info.relmse_epsilon = req.relmse_epsilon;
+            return Ok(Reference {
+                mean,
+                variance,
+                info,
+                cached: true,
+            });
+        }
+    }
+    eprintln!(
+        "rendering the reference ({} at {} spp); it is cached in {} for later runs",
+        req.strategy.label(),
+        req.spp,
+        dir.display()
+    );
+    let out = render(
+        req.scene,
+        req.strategy,
+        &RenderSettings {
+            spp: req.spp,
+            seed: req.seed,
+            threads: req.threads,
+            progress: req.progress,
+        },
+    );
+    let (mse_floor, relmse_floor) = noise_floor(&out.mean, &out.variance, req.relmse_epsilon);
+    let info = ReferenceInfo {
+        key: req.key.clone(),
+        strategy: req.strategy.label(),
+        spp: req.spp,
+        seed: req.seed,
+        seconds: out.seconds,
+        non_finite_samples: out.non_finite_samples,
+        mse_floor,
+        relmse_floor,
+        relmse_epsilon: req.relmse_epsilon,
+    };
+    let (m, v, j) = paths(dir, &req.key);
+    film::write_exr(&m, &out.mean)?;
+    film::write_exr(&v, &out.variance)?;
+    // The JSON goes last: its presence marks a complete entry.
+    let json = serde_json::to_string_pretty(&info).map_err(|e| e.to_string())?;
+    film::write_atomic(&j, |tmp| {
+        std::fs::write(tmp, json).map_err(|e| format!("{}: {e}", j.display()))
+    })?;
+    Ok(Reference {
+        mean: out.mean,
+        variance: out.variance,
+        info,
+        cached: false,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::desc::{Heuristic, StrategyKind};
+
+    fn strategy() -> Strategy {
+        Strategy {
+            kind: StrategyKind::Mis,
+            heuristic: Heuristic::Balance,
+            emitter_samples: 1,
+            bsdf_samples: 1,
+            selection: crate::emitter::EmitterSelection::Uniform,
+            light_sampling: crate::emitter::LightSampling::Area,
+            hide_emitters: false,
+        }
+    }
+
+    #[test]
+    fn key_follows_scene_files_defines_and_settings() {
+        let dir = std::env::temp_dir().join(format!("directlab-key-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/triangle-light");
+        for f in ["triangle-light.xml", "triangle.obj"] {
+            std::fs::copy(src.join(f), dir.join(f)).unwrap();
+        }
+        let scene = dir.join("triangle-light.xml");
+        let s = strategy();
+        let defines = vec![("res".to_string(), "16".to_string())];
+        let k = |defines: &[(String, String)], spp: u32, st: &Strategy| {
+            reference_key(&KeyInputs {
+                scene: &scene,
+                defines,
+                spp,
+                seed: 99,
+                strategy: st,
+            })
+            .unwrap()
+        };
+        let base = k(&defines, 64, &s);
+        assert_eq!(base, k(&defines, 64, &s), "deterministic");
+        assert_eq!(
+            scene_files(&scene, &defines).unwrap(),
+            vec![scene.clone(), dir.join("triangle.obj")]
+        );
+        assert_ne!(base, k(&[], 64, &s));
+        assert_ne!(base, k(&defines, 128, &s));
+        let power = Strategy {
+            heuristic: Heuristic::Power,
+            ..s
+        };
+        assert_ne!(base, k(&defines, 64, &power));
+        // A change to a referenced mesh, not to the XML, must change the key too.
+        let obj = dir.join("triangle.obj");
+        let text = std::fs::read_to_string(&obj).unwrap();
+        std::fs::write(&obj, text.replace("v 0.5 1 -0.5", "v 0.5 1.01 -0.5")).unwrap();
+        assert_ne!(
+            std::fs::read_to_string(&obj).unwrap(),
+            text,
+            "the edit must apply"
+        );
+        assert_ne!(base, k(&defines, 64, &s));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn noise_floor_is_mean_variance_and_relative_variance() {
+        let mut mean = Image::new(2, 1);
+        let mut var = Image::new(2, 1);
+        mean.set(0, 0, [1.0; 3]);
+        var.set(0, 0, [0.3; 3]);
+        var.set(1, 0, [0.1; 3]);
+        let (m, r) = noise_floor(&mean, &var, 1.0);
+        assert!((m - 0.2).abs() < 1e-12);
+        assert!((r - (0.3 / 2.0 + 0.1 / 1.0) / 2.0).abs() < 1e-12);
+    }
+}

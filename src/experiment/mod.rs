@@ -1,0 +1,62 @@
+//! The experiment runner: sweeps of (strategy, spp, seed) against a cached reference, with
+//! resumable results, left-out analysis, figures and a report per experiment.
+
+pub mod analysis;
+pub mod cache;
+pub mod figures;
+pub mod leftout;
+pub mod results;
+pub mod runner;
+pub mod schema;
+
+pub use runner::{run_experiment, Outcome, RunOptions};
+pub use schema::{load, Resolved};
+use std::path::{Path, PathBuf};
+
+/// Runs one experiment file and writes its figures and report; prints the mean check.
+pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(), String> {
+    let exp = load(file, quick)?;
+    let o = run_experiment(exp, opts)?;
+    let (series, mut figs) = figures::charts(&o)?;
+    figs.extend(figures::images(&o)?);
+    crate::report::write_experiment(&o, &series, &figs)?;
+    for l in crate::report::mean_check_lines(&o) {
+        println!("{}: {l}", o.exp.name);
+    }
+    println!(
+        "{}: {} runs ({} rendered now) in {:.1} s -> {}",
+        o.exp.name,
+        o.rows.len(),
+        o.rendered,
+        o.seconds,
+        o.dir.join("index.md").display()
+    );
+    Ok(())
+}
+
+/// The `experiments/` folder: in the working directory, else in the source tree this binary
+/// was built from (so `cargo run -- reproduce` works from anywhere in a clone).
+pub fn experiments_dir() -> Result<PathBuf, String> {
+    let local = PathBuf::from("experiments");
+    if local.is_dir() {
+        return Ok(local);
+    }
+    let built = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
+    if built.is_dir() {
+        return Ok(built);
+    }
+    Err("no experiments/ folder in the working directory; run from the repository root".into())
+}
+
+/// Every `*.toml` in the experiments folder, sorted.
+pub fn all_experiments() -> Result<Vec<PathBuf>, String> {
+    let dir = experiments_dir()?;
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    v.sort();
+    Ok(v)
+}

@@ -1,0 +1,201 @@
+//! `results.csv`: one row per render, rewritten atomically after every row so an interrupted
+//! sweep resumes where it stopped. Rows carry a `context` hash (reference key + epsilon): rows
+//! made against another scene, reference or epsilon are dropped on load, never mixed in.
+
+use crate::film::write_atomic;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// What kind of run a row is: a point of the spp sweep, or an equal-time run whose spp was
+/// derived from a time budget.
+pub const SWEEP: &str = "spp";
+pub const EQUAL_TIME: &str = "time";
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Row {
+    pub context: String,
+    /// Stable label (`Strategy::label`), the resume key; `name` is the legend name.
+    pub strategy: String,
+    pub name: String,
+    pub kind: String,
+    /// Time budget in seconds for equal-time rows, 0 for sweep rows.
+    pub budget_s: f64,
+    pub spp: u32,
+    pub seed: u64,
+    pub width: u32,
+    pub height: u32,
+    pub seconds: f64,
+    pub samples_per_s: f64,
+    pub mse: f64,
+    /// MSE minus the reference's noise floor (its mean per-pixel variance); may be negative
+    /// when the error is at the floor, which `near_floor` flags.
+    pub mse_corrected: f64,
+    pub relmse: f64,
+    pub relmse_corrected: f64,
+    pub relmse_eps: f64,
+    /// MSE this run's own variance image predicts (mean variance of its pixel means); for an
+    /// unbiased estimator E[mse_corrected] equals it. Zero at 1 spp (no variance estimate).
+    pub mse_predicted: f64,
+    /// The same for relMSE: mean of variance / (r^2 + eps). A measured relMSE far below it at
+    /// low spp points to a heavy-tailed estimator (rare large samples not yet drawn).
+    pub relmse_predicted: f64,
+    /// Mean over pixels and channels of (x - r)^2 / (var_x + var_r): about 1 when run and
+    /// reference have the same expectation (above 1 by (n-1)/(n-3) at small spp n, from the
+    /// estimated variances). Well above 1 at high spp means a bias. NaN at 1 spp.
+    pub mean_z2: f64,
+    pub mean_r: f64,
+    pub mean_g: f64,
+    pub mean_b: f64,
+    /// Variance of the image mean per channel, from the per-pixel variance image.
+    pub mean_var_r: f64,
+    pub mean_var_g: f64,
+    pub mean_var_b: f64,
+    pub non_finite: u64,
+    /// Measured error within 2x of the reference's noise floor: not trustworthy.
+    pub near_floor: bool,
+}
+
+impl Row {
+    pub fn mean(&self) -> [f64; 3] {
+        [self.mean_r, self.mean_g, self.mean_b]
+    }
+
+    pub fn mean_var(&self) -> [f64; 3] {
+        [self.mean_var_r, self.mean_var_g, self.mean_var_b]
+    }
+
+    pub fn is_sweep(&self) -> bool {
+        self.kind == SWEEP
+    }
+}
+
+/// The rows of one experiment and where they are stored.
+pub struct Results {
+    pub rows: Vec<Row>,
+    /// Rows of the file that belonged to another context and were dropped.
+    pub dropped: usize,
+}
+
+impl Results {
+    /// Reads `path` keeping the rows of `context`; a missing file is an empty table.
+    pub fn load(path: &Path, context: &str) -> Result<Results, String> {
+        if !path.exists() {
+            return Ok(Results {
+                rows: Vec::new(),
+                dropped: 0,
+            });
+        }
+        let mut rd =
+            csv::Reader::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut rows = Vec::new();
+        let mut dropped = 0;
+        for r in rd.deserialize::<Row>() {
+            match r {
+                Ok(row) if row.context == context => rows.push(row),
+                // Old columns or another context: recompute rather than trust.
+                _ => dropped += 1,
+            }
+        }
+        Ok(Results { rows, dropped })
+    }
+
+    pub fn find_sweep(&self, strategy: &str, spp: u32, seed: u64) -> Option<&Row> {
+        self.rows
+            .iter()
+            .find(|r| r.is_sweep() && r.strategy == strategy && r.spp == spp && r.seed == seed)
+    }
+
+    /// Equal-time rows are keyed by budget, not spp: the spp came from a timing measurement
+    /// and would differ on the next run.
+    pub fn find_equal_time(&self, strategy: &str, budget: f64, seed: u64) -> Option<&Row> {
+        self.rows.iter().find(|r| {
+            r.kind == EQUAL_TIME && r.strategy == strategy && r.budget_s == budget && r.seed == seed
+        })
+    }
+
+    pub fn push_and_save(&mut self, row: Row, path: &Path) -> Result<(), String> {
+        self.rows.push(row);
+        self.save(path)
+    }
+
+    pub fn save(&self, path: &Path) -> Result<(), String> {
+        write_atomic(path, |tmp| {
+            let mut w = csv::Writer::from_path(tmp).map_err(|e| e.to_string())?;
+            for r in &self.rows {
+                w.serialize(r).map_err(|e| e.to_string())?;
+            }
+            w.flush().map_err(|e| e.to_string())
+        })
+    }
+}
+
+#[cfg(test)]
+pub(crate) fn test_row(strategy: &str, spp: u32, seed: u64) -> Row {
+    Row {
+        context: "ctx".into(),
+        strategy: strategy.into(),
+        name: strategy.into(),
+        kind: SWEEP.into(),
+        budget_s: 0.0,
+        spp,
+        seed,
+        width: 4,
+        height: 4,
+        seconds: 0.5,
+        samples_per_s: 1e6,
+        mse: 1.0 / spp as f64,
+        mse_corrected: 1.0 / spp as f64,
+        relmse: 0.5 / spp as f64,
+        relmse_corrected: 0.5 / spp as f64,
+        relmse_eps: 0.01,
+        mse_predicted: 0.0,
+        relmse_predicted: 0.0,
+        mean_z2: 1.0,
+        mean_r: 0.1,
+        mean_g: 0.2,
+        mean_b: 0.3,
+        mean_var_r: 1e-6,
+        mean_var_g: 1e-6,
+        mean_var_b: 1e-6,
+        non_finite: 0,
+        near_floor: false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_keeps_own_context_and_drops_others() {
+        let dir = std::env::temp_dir().join(format!("directlab-res-{}", std::process::id()));
+        let path = dir.join("results.csv");
+        let mut res = Results::load(&path, "ctx").unwrap();
+        assert!(res.rows.is_empty());
+        res.push_and_save(test_row("light", 4, 0), &path).unwrap();
+        let mut other = test_row("light", 8, 1);
+        other.context = "old".into();
+        res.push_and_save(other, &path).unwrap();
+        let mut t = test_row("mis", 16, 0);
+        t.kind = EQUAL_TIME.into();
+        t.budget_s = 0.25;
+        res.push_and_save(t.clone(), &path).unwrap();
+
+        let back = Results::load(&path, "ctx").unwrap();
+        assert_eq!(back.rows.len(), 2);
+        assert_eq!(back.dropped, 1);
+        assert_eq!(back.rows[0], test_row("light", 4, 0));
+        assert!(back.find_sweep("light", 4, 0).is_some());
+        assert!(back.find_sweep("light", 4, 1).is_none());
+        assert!(
+            back.find_sweep("mis", 16, 0).is_none(),
+            "equal-time is not a sweep row"
+        );
+        assert_eq!(back.find_equal_time("mis", 0.25, 0), Some(&t));
+        assert!(back.find_equal_time("mis", 0.5, 0).is_none());
+        let header = std::fs::read_to_string(&path).unwrap();
+        assert!(header.starts_with("context,strategy,name,kind,budget_s,spp,seed"));
+        assert!(header.lines().next().unwrap().contains("relmse_eps"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,161 @@
+//! End to end through `directlab run --quick`, as a user runs it: results, plots and report
+//! appear, and a second run resumes instead of rendering again.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo(p: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(p)
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("directlab-exp-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run_quick(exp: &str, out: &Path) -> Output {
+    let o = Command::new(env!("CARGO_BIN_EXE_directlab"))
+        .args([
+            "run",
+            repo(exp).to_str().unwrap(),
+            "--quick",
+            "--threads",
+            "2",
+        ])
+        .arg("--out")
+        .arg(out)
+        .output()
+        .expect("run directlab");
+    if !o.status.success() {
+        eprintln!("stderr: {}", String::from_utf8_lossy(&o.stderr));
+    }
+    o
+}
+
+#[test]
+fn quick_experiment_writes_results_plots_report_and_resumes() {
+    let out = scratch("fig2");
+    let first = run_quick("experiments/fig2.toml", &out);
+    assert!(first.status.success());
+    let dir = out.join("fig2-quick");
+    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    // [quick]: 2 strategies x spp [1, 4, 16] x 2 seeds, plus one equal-time run per strategy.
+    assert_eq!(rows.len(), 2 * 3 * 2 + 2, "{csv}");
+    let header = csv.lines().next().unwrap();
+    for col in [
+        "strategy",
+        "spp",
+        "seed",
+        "mse",
+        "relmse",
+        "relmse_eps",
+        "seconds",
+        "samples_per_s",
+        "mean_r",
+    ] {
+        assert!(
+            header.split(',').any(|c| c == col),
+            "no column {col}: {header}"
+        );
+    }
+    assert!(
+        rows.iter().all(|r| r.contains(",0.01,")),
+        "epsilon stated per row"
+    );
+    for f in [
+        "convergence.png",
+        "convergence.svg",
+        "error_vs_time.png",
+        "error_vs_time.svg",
+        "efficiency.png",
+        "efficiency.svg",
+        "equal_spp.png",
+        "equal_time_0.02s.png",
+        "variance.png",
+        "index.md",
+    ] {
+        assert!(dir.join(f).exists(), "missing {f}");
+    }
+    let index = std::fs::read_to_string(dir.join("index.md")).unwrap();
+    assert!(index.contains("## Left out") && index.contains("noise floor"));
+    assert!(index.contains("convergence.png"));
+    let root = std::fs::read_to_string(out.join("index.md")).unwrap();
+    assert!(root.contains("fig2-quick/index.md"), "{root}");
+    let stdout = String::from_utf8_lossy(&first.stdout);
+    assert!(
+        stdout.contains("95% CI"),
+        "mean difference printed: {stdout}"
+    );
+    assert!(stdout.contains("(14 rendered now)"), "{stdout}");
+
+    // Resume: nothing is rendered again and the rows are kept as they were.
+    let second = run_quick("experiments/fig2.toml", &out);
+    assert!(second.status.success());
+    let stdout = String::from_utf8_lossy(&second.stdout);
+    assert!(stdout.contains("(0 rendered now)"), "{stdout}");
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    assert!(stderr.contains("cached"), "reference reused: {stderr}");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("results.csv")).unwrap(),
+        csv
+    );
+
+    // An interrupted sweep: drop the last sweep rows; only they are rendered again.
+    let kept: Vec<&str> = csv.lines().take(1 + 10).collect();
+    std::fs::write(dir.join("results.csv"), kept.join("\n") + "\n").unwrap();
+    let third = run_quick("experiments/fig2.toml", &out);
+    assert!(third.status.success());
+    let stdout = String::from_utf8_lossy(&third.stdout);
+    assert!(stdout.contains("(4 rendered now)"), "{stdout}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn scene_with_one_emitter_leaves_out_power_choice_with_its_reason() {
+    let out = scratch("leftout");
+    let exp = out.join("one-light.toml");
+    let scene = repo("scenes/cbox/cbox.xml");
+    std::fs::write(
+        &exp,
+        format!(
+            r#"
+scene = "{}"
+defines = {{ res = "8" }}
+spp = [1, 2]
+seeds = 1
+[reference]
+spp = 16
+[[strategy]]
+name = "uniform"
+strategy = "light"
+[[strategy]]
+name = "power"
+strategy = "light"
+emitter_selection = "power"
+"#,
+            scene.display().to_string().replace('\\', "/")
+        ),
+    )
+    .unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_directlab"))
+        .args(["run", exp.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let index = std::fs::read_to_string(out.join("one-light/index.md")).unwrap();
+    assert!(
+        index.contains("**power** (`light-e1-pow-area`): identical to 'uniform'"),
+        "{index}"
+    );
+    assert!(index.contains("one emitter"));
+    let csv = std::fs::read_to_string(out.join("one-light/results.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        1 + 2,
+        "only the kept strategy runs: {csv}"
+    );
+    std::fs::remove_dir_all(&out).unwrap();
+}
