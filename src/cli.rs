@@ -25,6 +25,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a Mitsuba 3, Mitsuba 0.6 or Nori XML scene to EXR (plus an sRGB PNG preview).
     Render(RenderArgs),
+    /// Measure render throughput per strategy and thread count.
+    Bench(crate::bench::BenchArgs),
     /// Chi-square tests of every sampling routine against its pdf (warps, BSDFs, emitters),
     /// with heat maps; exits non-zero if any case fails.
     Chi2(crate::chi2cases::command::Chi2Args),
@@ -246,6 +248,7 @@ pub fn main() -> i32 {
     let cli = Cli::parse();
     let r = match &cli.command {
         Command::Render(a) => cmd_render(a),
+        Command::Bench(a) => crate::bench::run(a),
         Command::Chi2(a) => crate::chi2cases::command::run(a).and_then(|ok| {
             ok.then_some(())
                 .ok_or_else(|| "some sampling routines do not match their pdfs".to_string())

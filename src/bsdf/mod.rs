@@ -4,9 +4,20 @@
 //! Conventions (as Mitsuba): `wi` is the direction towards the viewer/previous vertex,
 //! `wo` the sampled direction towards the light; `eval` includes the |cos| of `wo`.
 
+mod conductor;
+mod dielectric;
 mod diffuse;
+pub mod fresnel;
+mod mirror;
+mod nori_microfacet;
+mod roughconductor;
 
+pub use conductor::Conductor;
+pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use mirror::Mirror;
+pub use nori_microfacet::NoriMicrofacet;
+pub use roughconductor::RoughConductor;
 
 use crate::math::Rgb;
 use glam::{Vec2, Vec3};
@@ -25,6 +36,11 @@ pub struct BsdfSample {
 #[derive(Clone, Debug)]
 pub enum BsdfKind {
     Diffuse(Diffuse),
+    Conductor(Conductor),
+    RoughConductor(RoughConductor),
+    Dielectric(Dielectric),
+    NoriMicrofacet(NoriMicrofacet),
+    Mirror(Mirror),
 }
 
 /// A material: a BSDF and whether it is used on both sides of the surface.
@@ -48,7 +64,10 @@ impl Material {
     /// True if every lobe is a Dirac delta (light sampling is then useless).
     pub fn is_delta(&self) -> bool {
         match &self.kind {
-            BsdfKind::Diffuse(_) => false,
+            BsdfKind::Conductor(_) | BsdfKind::Dielectric(_) | BsdfKind::Mirror(_) => true,
+            BsdfKind::Diffuse(_) | BsdfKind::RoughConductor(_) | BsdfKind::NoriMicrofacet(_) => {
+                false
+            }
         }
     }
 
@@ -57,6 +76,10 @@ impl Material {
         let (wi, wo) = self.orient(wi, wo);
         match &self.kind {
             BsdfKind::Diffuse(b) => b.eval(wi, wo),
+            BsdfKind::RoughConductor(b) => b.eval(wi, wo),
+            BsdfKind::NoriMicrofacet(b) => b.eval(wi, wo),
+            // Delta lobes have no density to evaluate.
+            BsdfKind::Conductor(_) | BsdfKind::Dielectric(_) | BsdfKind::Mirror(_) => Rgb::ZERO,
         }
     }
 
@@ -65,6 +88,9 @@ impl Material {
         let (wi, wo) = self.orient(wi, wo);
         match &self.kind {
             BsdfKind::Diffuse(b) => b.pdf(wi, wo),
+            BsdfKind::RoughConductor(b) => b.pdf(wi, wo),
+            BsdfKind::NoriMicrofacet(b) => b.pdf(wi, wo),
+            BsdfKind::Conductor(_) | BsdfKind::Dielectric(_) | BsdfKind::Mirror(_) => 0.0,
         }
     }
 
@@ -77,9 +103,13 @@ impl Material {
         } else {
             wi
         };
-        let _ = u1;
         let mut s = match &self.kind {
             BsdfKind::Diffuse(b) => b.sample(wi_up, u2)?,
+            BsdfKind::Conductor(b) => b.sample(wi_up)?,
+            BsdfKind::RoughConductor(b) => b.sample(wi_up, u2)?,
+            BsdfKind::Dielectric(b) => b.sample(wi_up, u1)?,
+            BsdfKind::NoriMicrofacet(b) => b.sample(wi_up, u1, u2)?,
+            BsdfKind::Mirror(b) => b.sample(wi_up)?,
         };
         if flip {
             s.wo.z = -s.wo.z;
@@ -101,29 +131,65 @@ pub(crate) mod testing {
         let mut rng = Rng::new(17, 3);
         for _ in 0..n {
             let wi = square_to_uniform_sphere(rng.next_2d());
-            let Some(s) = m.sample(wi, rng.next_f32(), rng.next_2d()) else {
-                continue;
-            };
-            assert!(
-                s.weight.is_finite() && s.pdf.is_finite() && s.pdf > 0.0,
-                "{s:?}"
-            );
-            if s.delta {
-                continue;
-            }
-            let pdf = m.pdf(wi, s.wo);
-            assert!(
-                (pdf - s.pdf).abs() <= 1e-3 * s.pdf,
-                "pdf {pdf} vs sampled {}",
-                s.pdf
-            );
-            let w = m.eval(wi, s.wo) / s.pdf;
-            assert!(
-                (w - s.weight).abs().max_element() <= 1e-3 * w.max_element().max(1e-3),
-                "{w} vs {}",
-                s.weight
-            );
+            check_one(m, wi, &mut rng);
         }
+    }
+
+    /// As `check_sample_consistency` for one incident direction; returns the worst relative
+    /// mismatch seen (pdf or weight), for reports.
+    pub fn check_sample_consistency_at(m: &Material, wi: Vec3, n: usize) -> f32 {
+        let mut rng = Rng::new(19, 4);
+        (0..n).fold(0.0, |w, _| w.max(check_one(m, wi, &mut rng)))
+    }
+
+    fn check_one(m: &Material, wi: Vec3, rng: &mut Rng) -> f32 {
+        let Some(s) = m.sample(wi, rng.next_f32(), rng.next_2d()) else {
+            return 0.0;
+        };
+        assert!(
+            s.weight.is_finite() && s.pdf.is_finite() && s.pdf > 0.0,
+            "{s:?}"
+        );
+        assert!(s.weight.min_element() >= 0.0, "{s:?}");
+        if s.delta {
+            assert!(s.pdf <= 1.0, "{s:?}");
+            return 0.0;
+        }
+        let pdf = m.pdf(wi, s.wo);
+        let e_pdf = (pdf - s.pdf).abs() / s.pdf;
+        assert!(
+            e_pdf <= 1e-3,
+            "wi {wi} wo {}: pdf {pdf} vs sampled {}",
+            s.wo,
+            s.pdf
+        );
+        let w = m.eval(wi, s.wo) / s.pdf;
+        let e_w = (w - s.weight).abs().max_element() / w.max_element().max(1e-3);
+        assert!(e_w <= 1e-3, "wi {wi} wo {}: {w} vs {}", s.wo, s.weight);
+        e_pdf.max(e_w)
+    }
+
+    /// Fraction of `sample` calls that return a direction, and the albedo estimate with it.
+    pub fn success_rate(m: &Material, wi: Vec3, n: usize) -> f64 {
+        let mut rng = Rng::new(29, 6);
+        (0..n)
+            .filter(|_| m.sample(wi, rng.next_f32(), rng.next_2d()).is_some())
+            .count() as f64
+            / n as f64
+    }
+
+    /// ∫ eval(wi, wo) dwo and ∫ pdf(wi, wo) dwo by quadrature on `grid` (independent of
+    /// the samplers).
+    pub fn quadrature(
+        m: &Material,
+        wi: Vec3,
+        grid: &crate::sampling::quadrature::LobeGrid,
+    ) -> (Rgb, f64) {
+        let [r, g, b, p] = grid.integrate_n(|wo| {
+            let e = m.eval(wi, wo).as_dvec3();
+            [e.x, e.y, e.z, m.pdf(wi, wo) as f64]
+        });
+        (Rgb::new(r as f32, g as f32, b as f32), p)
     }
 
     /// Directional albedo by sampling: E[weight] for a fixed wi. Returns (mean, std error).

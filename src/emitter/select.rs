@@ -59,3 +59,82 @@ impl EmitterSelector {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::emitter::{AreaLight, PointLight};
+    use crate::math::Rgb;
+    use crate::rng::Rng;
+    use crate::stats::chi2::{chi2_sf, pearson};
+    use glam::Vec3;
+
+    fn emitters() -> Vec<Emitter> {
+        let area = |area: f32, l: f32| {
+            Emitter::Area(AreaLight {
+                shape: 0,
+                radiance: Rgb::splat(l),
+                area,
+                triangles: None,
+            })
+        };
+        vec![
+            area(0.01, 100.0),
+            area(4.0, 0.5),
+            area(1.0, 0.0),
+            Emitter::Point(PointLight {
+                position: Vec3::ZERO,
+                intensity: Rgb::new(1.0, 2.0, 0.5),
+            }),
+            area(0.2, 3.0),
+        ]
+    }
+
+    #[test]
+    fn power_pmf_is_proportional_to_power() {
+        let e = emitters();
+        let sel = EmitterSelector::new(&e, EmitterSelection::Power);
+        let total: f64 = e.iter().map(Emitter::power).sum();
+        for (i, em) in e.iter().enumerate() {
+            assert!((sel.pmf(i) as f64 - em.power() / total).abs() < 1e-6);
+        }
+        // pi * A * L for area lights, 4 pi * luminance(I) for point lights.
+        assert!((e[0].power() - std::f64::consts::PI * 0.01 * 100.0).abs() < 1e-4);
+        assert_eq!(sel.pmf(2), 0.0);
+    }
+
+    /// Chi-square of 1M choices against the pmf, alpha = 0.01, for both selection modes; and
+    /// the sampled pmf equals pmf(i).
+    #[test]
+    fn choice_frequencies_match_pmf() {
+        let e = emitters();
+        for mode in [EmitterSelection::Uniform, EmitterSelection::Power] {
+            let sel = EmitterSelector::new(&e, mode);
+            let n = 1_000_000;
+            let mut counts = vec![0.0f64; e.len()];
+            let mut rng = Rng::new(31, 7);
+            for _ in 0..n {
+                let (i, pmf) = sel.sample(rng.next_f32()).unwrap();
+                assert_eq!(pmf, sel.pmf(i));
+                counts[i] += 1.0;
+            }
+            let mut cells: Vec<(f64, f64)> = Vec::new();
+            for (i, &c) in counts.iter().enumerate() {
+                let expected = sel.pmf(i) as f64 * n as f64;
+                if expected == 0.0 {
+                    assert_eq!(c, 0.0, "emitter {i} has pmf 0 but was chosen");
+                } else {
+                    cells.push((c, expected));
+                }
+            }
+            let p = pearson(&mut cells, 5.0).unwrap();
+            let pv = chi2_sf(p.statistic, p.dof);
+            assert!(
+                pv > 0.01,
+                "{mode:?}: chi2 {} dof {} p {pv}",
+                p.statistic,
+                p.dof
+            );
+        }
+    }
+}

@@ -4,6 +4,10 @@
 //! pmf(emitter) * pdf_emitter(direction); the BSDF technique's is the BSDF's pdf. Multi-sample
 //! MIS weights each technique with h(n_i p_i, n_j p_j) (Veach's heuristics); one-sample MIS
 //! picks a technique with probability c_i and weights by h(c_i p_i, c_j p_j) / c_i.
+//!
+//! Paths only one technique can produce (delta BSDFs: BSDF sampling only; delta lights: light
+//! sampling only) are handled by that technique with weight 1 in every strategy, including
+//! the pure ones, so no strategy loses them and none counts them twice.
 
 use super::Strategy;
 use crate::bsdf::Material;
@@ -19,6 +23,7 @@ pub struct Direct<'a> {
     pub scene: &'a Scene,
     pub strategy: Strategy,
     selector: EmitterSelector,
+    has_delta_lights: bool,
 }
 
 #[inline]
@@ -48,6 +53,7 @@ impl<'a> Direct<'a> {
             scene,
             strategy,
             selector: EmitterSelector::new(&scene.emitters, strategy.selection),
+            has_delta_lights: scene.emitters.iter().any(|e| e.is_delta()),
         }
     }
 
@@ -76,7 +82,16 @@ impl<'a> Direct<'a> {
         // A delta BSDF gives light samples zero throughput: all its light arrives via BSDF
         // samples, which then carry weight 1.
         let delta_bsdf = sh.mat.is_delta();
+        // The pure strategies fall back to the other technique for the paths only it can
+        // produce (delta BSDFs for light sampling, delta lights for BSDF sampling): weight 1
+        // where the own technique's density is 0, else 0. Nothing is lost or counted twice.
+        let only_other = |_: f32, p_own: f32| if p_own == 0.0 { 1.0 } else { 0.0 };
         match s.kind {
+            StrategyKind::Light if delta_bsdf => {
+                for _ in 0..s.emitter_samples {
+                    l += self.bsdf_sample(&sh, rng, only_other) / ne;
+                }
+            }
             StrategyKind::Light => {
                 for _ in 0..s.emitter_samples {
                     l += self.light_sample(&sh, rng, |_, _| 1.0) / ne;
@@ -85,6 +100,11 @@ impl<'a> Direct<'a> {
             StrategyKind::Bsdf => {
                 for _ in 0..s.bsdf_samples {
                     l += self.bsdf_sample(&sh, rng, |_, _| 1.0) / nb;
+                }
+                if self.has_delta_lights && !delta_bsdf {
+                    for _ in 0..s.bsdf_samples {
+                        l += self.light_sample(&sh, rng, only_other) / nb;
+                    }
                 }
             }
             StrategyKind::Mis => {

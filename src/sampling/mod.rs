@@ -1,6 +1,10 @@
 //! Sampling routines: warps of the unit square and discrete distributions.
 
 pub mod discrete;
+pub(crate) mod erf;
+pub mod microfacet;
+#[cfg(test)]
+pub(crate) mod quadrature;
 pub mod spherical;
 pub mod warps;
 

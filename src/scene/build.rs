@@ -2,11 +2,14 @@
 //! and the BVH. Checks what only makes sense once geometry is known (degenerate emitters).
 
 use super::desc::{BsdfDesc, SceneDesc, ShapeGeometry};
-use crate::bsdf::{BsdfKind, Diffuse, Material};
+use crate::bsdf::{
+    BsdfKind, Conductor, Dielectric, Diffuse, Material, Mirror, NoriMicrofacet, RoughConductor,
+};
 use crate::camera::Camera;
 use crate::emitter::{AreaLight, Emitter, LightSample, PointLight};
 use crate::geometry::{Accel, Hit, Mesh, Ray, Shape, ShapeKind, Sphere, SurfacePoint};
 use crate::math::{offset_origin, Rgb};
+use crate::sampling::microfacet::Microfacet;
 use crate::sampling::AliasTable;
 use std::fmt;
 
@@ -66,16 +69,89 @@ fn material(origin: &str, desc: &BsdfDesc, two_sided: bool) -> Result<Material, 
                 reflectance: *reflectance,
             })
         }
-        other => {
-            let name = format!("{other:?}");
-            let name = name.split([' ', '{', '(']).next().unwrap_or("");
-            return Err(err(
-                origin,
-                format!("material '{name}' is not supported yet"),
-            ));
+        BsdfDesc::Conductor {
+            eta,
+            k,
+            specular_reflectance,
+        } => {
+            check_rgb(origin, "conductor eta", *eta)?;
+            check_rgb(origin, "conductor k", *k)?;
+            check_rgb(origin, "specular_reflectance", *specular_reflectance)?;
+            BsdfKind::Conductor(Conductor {
+                eta: *eta,
+                k: *k,
+                specular_reflectance: *specular_reflectance,
+            })
         }
+        BsdfDesc::RoughConductor {
+            distribution,
+            alpha_u,
+            alpha_v,
+            sample_visible,
+            eta,
+            k,
+            specular_reflectance,
+        } => {
+            check_rgb(origin, "roughconductor eta", *eta)?;
+            check_rgb(origin, "roughconductor k", *k)?;
+            check_rgb(origin, "specular_reflectance", *specular_reflectance)?;
+            check_positive(origin, "roughconductor alpha_u", *alpha_u)?;
+            check_positive(origin, "roughconductor alpha_v", *alpha_v)?;
+            BsdfKind::RoughConductor(RoughConductor {
+                mf: Microfacet::new(*distribution, *alpha_u, *alpha_v),
+                sample_visible: *sample_visible,
+                eta: *eta,
+                k: *k,
+                specular_reflectance: *specular_reflectance,
+            })
+        }
+        BsdfDesc::Dielectric { int_ior, ext_ior } => {
+            check_positive(origin, "dielectric int_ior", *int_ior)?;
+            check_positive(origin, "dielectric ext_ior", *ext_ior)?;
+            // As Mitsuba: the inside is meaningful, so mirroring it to the outside would turn
+            // refraction into nonsense.
+            if two_sided {
+                return Err(err(
+                    origin,
+                    "twosided cannot wrap a dielectric (it already handles both sides)",
+                ));
+            }
+            BsdfKind::Dielectric(Dielectric {
+                eta: int_ior / ext_ior,
+            })
+        }
+        BsdfDesc::NoriMicrofacet {
+            alpha,
+            int_ior,
+            ext_ior,
+            kd,
+        } => {
+            check_positive(origin, "microfacet alpha", *alpha)?;
+            check_positive(origin, "microfacet intIOR", *int_ior)?;
+            check_positive(origin, "microfacet extIOR", *ext_ior)?;
+            check_rgb(origin, "microfacet kd", *kd)?;
+            // ks = 1 - max(kd) is the specular lobe's selection probability.
+            if kd.max_element() > 1.0 {
+                return Err(err(
+                    origin,
+                    format!("microfacet kd must not exceed 1 (ks = 1 - max(kd)), found {kd}"),
+                ));
+            }
+            BsdfKind::NoriMicrofacet(NoriMicrofacet::new(*alpha, *int_ior, *ext_ior, *kd))
+        }
+        BsdfDesc::Mirror => BsdfKind::Mirror(Mirror),
     };
     Ok(Material { kind, two_sided })
+}
+
+fn check_positive(origin: &str, what: &str, x: f32) -> Result<(), BuildError> {
+    if !(x.is_finite() && x > 0.0) {
+        return Err(err(
+            origin,
+            format!("{what} must be finite and positive, found {x}"),
+        ));
+    }
+    Ok(())
 }
 
 impl Scene {
@@ -109,11 +185,11 @@ impl Scene {
                             ),
                         ));
                     }
-                    ShapeKind::Mesh(Mesh {
-                        positions: positions.clone(),
-                        normals: normals.clone(),
-                        indices: indices.clone(),
-                    })
+                    ShapeKind::Mesh(Mesh::new(
+                        positions.clone(),
+                        normals.clone(),
+                        indices.clone(),
+                    ))
                 }
                 ShapeGeometry::Sphere {
                     center,
@@ -213,19 +289,24 @@ impl Scene {
     /// receiver nor the light itself counts as a blocker.
     #[inline]
     pub fn visible(&self, from: &SurfacePoint, ls: &LightSample) -> bool {
+        !self.accel.occluded(&Self::shadow_ray(from, ls))
+    }
+
+    /// The shadow ray `visible` traces (unnormalised direction, t in [0, 1 - 1e-4]).
+    #[inline]
+    pub fn shadow_ray(from: &SurfacePoint, ls: &LightSample) -> Ray {
         let o = from.spawn_origin(ls.p - from.p);
         let target = if ls.delta {
             ls.p
         } else {
             offset_origin(ls.p, ls.ng, ls.err_scale, o - ls.p)
         };
-        let ray = Ray {
+        Ray {
             o,
             d: target - o,
             tmin: 0.0,
             tmax: 1.0 - 1e-4,
-        };
-        !self.accel.occluded(&ray)
+        }
     }
 
     #[inline]
@@ -237,5 +318,92 @@ impl Scene {
     pub fn emitter_at(&self, sp: &SurfacePoint) -> Option<(usize, &Emitter)> {
         let e = self.shapes[sp.shape as usize].emitter? as usize;
         Some((e, &self.emitters[e]))
+    }
+}
+
+#[cfg(test)]
+mod bsdf_material_tests {
+    //! `material()` for every BSDF kind: accepted parameters and rejected ones.
+    use super::*;
+    use crate::scene::desc::MicrofacetDistribution;
+
+    fn rough(alpha_u: f32) -> BsdfDesc {
+        BsdfDesc::RoughConductor {
+            distribution: MicrofacetDistribution::Ggx,
+            alpha_u,
+            alpha_v: 0.1,
+            sample_visible: true,
+            eta: Rgb::new(0.2, 0.9, 1.1),
+            k: Rgb::new(3.9, 2.4, 1.6),
+            specular_reflectance: Rgb::ONE,
+        }
+    }
+
+    #[test]
+    fn bsdf_kinds_build_and_flag_delta() {
+        let cases = [
+            (BsdfDesc::Mirror, true),
+            (
+                BsdfDesc::Conductor {
+                    eta: Rgb::ZERO,
+                    k: Rgb::ONE,
+                    specular_reflectance: Rgb::ONE,
+                },
+                true,
+            ),
+            (
+                BsdfDesc::Dielectric {
+                    int_ior: 1.5046,
+                    ext_ior: 1.000277,
+                },
+                true,
+            ),
+            (rough(0.3), false),
+            (
+                BsdfDesc::NoriMicrofacet {
+                    alpha: 0.1,
+                    int_ior: 1.5,
+                    ext_ior: 1.0,
+                    kd: Rgb::splat(0.3),
+                },
+                false,
+            ),
+        ];
+        for (d, delta) in cases {
+            let m = material("t", &d, false).unwrap();
+            assert_eq!(m.is_delta(), delta, "{d:?}");
+        }
+        let m = material("t", &BsdfDesc::TwoSided(Box::new(rough(0.2))), false).unwrap();
+        assert!(m.two_sided);
+    }
+
+    #[test]
+    fn bsdf_parameters_are_checked() {
+        let bad = [
+            rough(0.0),
+            rough(f32::NAN),
+            BsdfDesc::Dielectric {
+                int_ior: -1.5,
+                ext_ior: 1.0,
+            },
+            BsdfDesc::TwoSided(Box::new(BsdfDesc::Dielectric {
+                int_ior: 1.5,
+                ext_ior: 1.0,
+            })),
+            BsdfDesc::Conductor {
+                eta: Rgb::new(0.2, f32::INFINITY, 1.0),
+                k: Rgb::ONE,
+                specular_reflectance: Rgb::ONE,
+            },
+            BsdfDesc::NoriMicrofacet {
+                alpha: 0.1,
+                int_ior: 1.5,
+                ext_ior: 1.0,
+                kd: Rgb::new(1.2, 0.1, 0.1),
+            },
+        ];
+        for d in bad {
+            assert!(material("t", &d, false).is_err(), "{d:?}");
+        }
     }
 }

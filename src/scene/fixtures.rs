@@ -76,15 +76,22 @@ fn floor(albedo: f32) -> ShapeDesc {
     )
 }
 
-/// A large diffuse floor z = 0 (normal +z) under `light`, seen by a one-pixel camera with a
-/// tiny field of view that looks at the receiver point `x` from `eye`.
-pub fn light_over_floor(light: ShapeDesc, albedo: f32, x: Vec3, eye: Vec3) -> SceneDesc {
+/// A large diffuse floor z = 0 (normal +z), seen by a one-pixel camera with a tiny field of
+/// view that looks at the receiver point `x` from `eye`. Add lights to it.
+pub fn floor_probe(albedo: f32, x: Vec3, eye: Vec3) -> SceneDesc {
     let up = if (eye - x).cross(Vec3::Y).length() > 1e-3 {
         Vec3::Y
     } else {
         Vec3::X
     };
-    base(look_at(eye, x, up), 1e-3, 1, 1, vec![floor(albedo), light])
+    base(look_at(eye, x, up), 1e-3, 1, 1, vec![floor(albedo)])
+}
+
+/// `floor_probe` under one area light.
+pub fn light_over_floor(light: ShapeDesc, albedo: f32, x: Vec3, eye: Vec3) -> SceneDesc {
+    let mut d = floor_probe(albedo, x, eye);
+    d.shapes.push(light);
+    d
 }
 
 /// A one-sided triangle light (emitting towards the side its counter-clockwise winding
