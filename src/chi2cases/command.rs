@@ -133,10 +133,16 @@ pub fn table(rows: &[Timed]) -> String {
     for t in rows {
         let o = &t.outcome;
         let c = &o.chi2;
+        // No statistic: an immediate verdict (impossible samples, or nothing to compare).
+        let stat = if c.statistic.is_nan() {
+            "-".to_string()
+        } else {
+            format!("{:.2}", c.statistic)
+        };
         s += &format!(
-            "{:<width$}  {:>12.2}  {:>6}  {:>10.3e}  {:>10.3e}  {:>7}\n",
+            "{:<width$}  {:>12}  {:>6}  {:>10.3e}  {:>10.3e}  {:>7}\n",
             o.name,
-            c.statistic,
+            stat,
             c.dof,
             c.p_value,
             c.threshold,
@@ -214,4 +220,49 @@ pub fn run(a: &Chi2Args) -> Result<bool, String> {
         a.out.display()
     );
     Ok(failed.is_empty())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writes_csv_and_heat_maps_and_reports_failures() {
+        let dir = std::env::temp_dir().join(format!("directlab-chi2cmd-{}", std::process::id()));
+        let args = Chi2Args {
+            filter: Some("warp/uniform-disk".into()),
+            samples: 20_000,
+            resolution: 11,
+            seed: 3,
+            out: dir.clone(),
+            list: false,
+        };
+        // 20k samples on 11 x 11 cells at alpha 0.01: a correct warp passes.
+        assert_eq!(run(&args), Ok(true));
+        let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 2, "{csv}");
+        assert!(lines[0].starts_with("case,domain,samples,resolution,seed,statistic,dof,p_value"));
+        assert!(lines[1].starts_with("warp/uniform-disk,unit disk,20000,11,3,"));
+        assert!(png_path(&dir, "warp/uniform-disk").exists());
+        let none = Chi2Args {
+            filter: Some("no-such-case".into()),
+            ..args
+        };
+        assert!(run(&none).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+
+        // A failing outcome is marked in the table.
+        let mut o = select("warp/uniform-disk")[0].run(&CaseConfig {
+            samples: 1000,
+            resolution: 5,
+            ..CaseConfig::default()
+        });
+        o.chi2.verdict = crate::stats::Verdict::Fail;
+        let t = table(&[Timed {
+            outcome: o,
+            seconds: 0.0,
+        }]);
+        assert!(t.lines().nth(1).unwrap().ends_with("FAIL"), "{t}");
+    }
 }

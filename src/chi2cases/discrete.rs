@@ -1,5 +1,6 @@
 //! Discrete distributions against their pmfs: the alias table, the emitter choice (uniform
-//! and by power) and a mesh light's triangle choice by area.
+//! and by power), a mesh light's triangle choice by area, and a dielectric's choice between
+//! reflection and refraction.
 //!
 //! The test is the same Pearson statistic as for continuous cases (Nori's pooling included),
 //! on one category per index; an index drawn whose pmf is 0 fails at once. The expected pmf
@@ -7,6 +8,7 @@
 //! table, so a table that stores a wrong pmf is caught too.
 
 use super::{emitters, Case, CaseConfig, Outcome};
+use crate::bsdf::{BsdfKind, Dielectric, Material};
 use crate::emitter::{AreaLight, Emitter, EmitterSelection, EmitterSelector};
 use crate::geometry::ShapeKind;
 use crate::math::luminance;
@@ -71,6 +73,12 @@ pub fn discrete_test(
             .map(|i| (r.observed.data[i], r.expected.data[i]))
             .collect();
         match pearson(&mut cells, 5.0) {
+            // One possible index (total internal reflection), always drawn: nothing to test.
+            None if cells.len() == 1 => {
+                r.verdict = Verdict::Pass;
+                r.p_value = 1.0;
+                r.reason = "a single possible index, always drawn".into();
+            }
             None => r.reason = "fewer than two usable categories".into(),
             Some(p) => {
                 r.statistic = p.statistic;
@@ -181,6 +189,61 @@ fn triangle_choice() -> Case {
     )
 }
 
+/// Unpolarised Fresnel reflectance of a smooth dielectric, written out independently of
+/// `bsdf::fresnel` in f64: `cos_i` < 0 means from inside (relative index `eta` below).
+fn fresnel_reflectance(cos_i: f64, eta: f64) -> f64 {
+    let (n1, n2, c) = if cos_i > 0.0 {
+        (1.0, eta, cos_i)
+    } else {
+        (eta, 1.0, -cos_i)
+    };
+    let sin_t = n1 / n2 * (1.0 - c * c).max(0.0).sqrt();
+    if sin_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin_t * sin_t).sqrt();
+    let rs = (n1 * c - n2 * cos_t) / (n1 * c + n2 * cos_t);
+    let rp = (n2 * c - n1 * cos_t) / (n2 * c + n1 * cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// The dielectric's choice between its two delta lobes (index 0 reflection, 1 refraction)
+/// against the Fresnel reflectance, from outside (normal, oblique, grazing) and inside
+/// (partial reflection, and total internal reflection).
+fn dielectric_lobes() -> Vec<Case> {
+    let eta = 1.5046f32 / 1.000277;
+    let views = [
+        ("normal", 1.0f32),
+        ("oblique", 0.5),
+        ("grazing", 0.01),
+        ("inside", -0.9),
+        ("inside-tir", -0.5),
+    ];
+    views
+        .into_iter()
+        .map(|(label, c)| {
+            let name = format!("discrete/dielectric-lobes-{label}");
+            let wi = glam::Vec3::new((1.0 - c * c).max(0.0).sqrt(), 0.0, c);
+            let r = fresnel_reflectance(c as f64, eta as f64);
+            let pmf = vec![r, 1.0 - r];
+            let m = Material {
+                kind: BsdfKind::Dielectric(Dielectric { eta }),
+                two_sided: false,
+            };
+            let about = format!("reflect vs refract for cos(theta_i) = {c} against Fresnel");
+            let label = name.clone();
+            Case::new(name, about, move |cfg| {
+                let lobe = |rng: &mut Rng| match m.sample(wi, rng.next_f32(), rng.next_2d()) {
+                    Some(s) if s.wo.z * wi.z > 0.0 => 0,
+                    Some(_) => 1,
+                    None => usize::MAX,
+                };
+                discrete_test(&label, &pmf, lobe, cfg)
+            })
+        })
+        .collect()
+}
+
 pub fn cases() -> Vec<Case> {
     let pmf = normalised(&ALIAS_WEIGHTS);
     let table = AliasTable::new(&ALIAS_WEIGHTS).expect("positive weights");
@@ -201,4 +264,7 @@ pub fn cases() -> Vec<Case> {
         emitter_choice(EmitterSelection::Power),
         triangle_choice(),
     ]
+    .into_iter()
+    .chain(dielectric_lobes())
+    .collect()
 }

@@ -16,6 +16,7 @@ pub mod checks;
 pub mod command;
 pub mod discrete;
 pub mod emitters;
+pub mod lobe;
 pub mod probe;
 pub mod tangent;
 pub mod warps;

@@ -106,10 +106,7 @@ impl Tangent {
     }
 
     /// Converts a solid-angle pdf into a density per unit area of the window's plane.
-    pub fn plane_pdf(
-        &self,
-        pdf: impl Fn(Vec3) -> f64 + Send + Sync,
-    ) -> impl Fn(Vec3) -> f64 + Send + Sync {
+    pub fn plane_pdf(&self, pdf: impl Fn(Vec3) -> f64) -> impl Fn(Vec3) -> f64 {
         let n = self.n;
         move |d: Vec3| {
             let c = d.as_dvec3().normalize().dot(n);

@@ -1,13 +1,16 @@
 //! Every warp of `sampling::warps` and the spherical-triangle sampler against its pdf.
 //!
 //! Warps onto [-1,1]^2 (the tent) are tested on the unit square after x -> (x + 1)/2, which
-//! scales the density by 4. Microfacet normal distributions plug in at [`microfacet_cases`].
+//! scales the density by 4. Microfacet normal distributions are in [`microfacet_cases`].
 
+use super::bsdfs;
+use super::lobe::{normal_window, run_windowed};
 use super::tangent::Tangent;
 use super::{Case, CaseConfig};
 use crate::analytic::triangle_solid_angle;
 use crate::geometry::shape::intersect_triangle;
 use crate::rng::Rng;
+use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
 use crate::sampling::spherical::sample_spherical_triangle;
 use crate::sampling::warps::*;
 use crate::stats::{Disk, Triangle};
@@ -142,13 +145,55 @@ pub fn cases() -> Vec<Case> {
     v
 }
 
-/// Beckmann and GGX normal distributions (D cos sampling) and their visible normals.
-///
-/// PLUG-IN POINT: `sampling::microfacet` lives on branch `wt-bsdf` and is not on main yet.
-/// Once merged, return here one case per (distribution, roughness in {1e-3, 1e-2, 0.1, 0.5,
-/// 1}, incident direction incl. cos 0.01), each built with `Case::continuous` on
-/// `c.sphere()` — or on `Tangent::cone` around +z with a sampler that returns None outside
-/// the window for roughness below ~0.05 (the lost category then carries the tail's mass).
+/// Beckmann and GGX normal distributions: D(m) cos(theta_m) sampling of all normals, and
+/// visible normals seen from normal, oblique and grazing incidence, across the roughness
+/// range of [`bsdfs::ROUGHNESS`]. Narrow distributions are tested in a window around +z.
 pub fn microfacet_cases() -> Vec<Case> {
-    Vec::new()
+    let mut v = Vec::new();
+    for d in [
+        MicrofacetDistribution::Beckmann,
+        MicrofacetDistribution::Ggx,
+    ] {
+        let dn = format!("{d:?}").to_lowercase();
+        for a in bsdfs::ROUGHNESS {
+            let mf = Microfacet::new(d, a.0, a.1);
+            let name = format!("warp/{dn}-{}-dcos", bsdfs::alpha_name(a));
+            let label = name.clone();
+            v.push(Case::new(
+                name,
+                format!("{dn} normals, density D(m) cos(theta_m), alpha {a:?}"),
+                move |cfg| {
+                    let window = normal_window(a, cfg.resolution);
+                    run_windowed(
+                        &label,
+                        window,
+                        |r| Some(mf.sample_all(r.next_2d())),
+                        |m| mf.pdf_all(m) as f64,
+                        cfg,
+                        vec![],
+                    )
+                },
+            ));
+            for (wname, wi) in bsdfs::incident().into_iter().filter(|(_, w)| w.z > 0.0) {
+                let name = format!("warp/{dn}-{}-vndf-{wname}", bsdfs::alpha_name(a));
+                let label = name.clone();
+                v.push(Case::new(
+                    name,
+                    format!("{dn} normals visible from {wi}, alpha {a:?}"),
+                    move |cfg| {
+                        let window = normal_window(a, cfg.resolution);
+                        run_windowed(
+                            &label,
+                            window,
+                            |r| Some(mf.sample_visible(wi, r.next_2d())),
+                            |m| mf.pdf_visible(wi, m) as f64,
+                            cfg,
+                            vec![],
+                        )
+                    },
+                ));
+            }
+        }
+    }
+    v
 }
