@@ -201,7 +201,8 @@ fn comparison(
     }
     let mut rows = vec![top, second];
     for (i, (cname, cx, cy, cw, ch)) in crops.iter().enumerate() {
-        let k = (160 / cw.max(ch)).max(1);
+        // Enlarged to about 160 px tall, but no wider than a panel.
+        let k = (160 / ch).min(PANEL / cw).max(1);
         let mut row = vec![panel_of(&r.mean, exposure, "")
             .crop(*cx, *cy, *cw, *ch)
             .enlarge(k)];

@@ -88,6 +88,7 @@ fn measure(ctx: &Ctx, job: &Job, out: &RenderOutput) -> Row {
     let mut var_sum = [0.0f64; 3];
     let mut rel_var = 0.0f64;
     let (mut z2, mut z2_n) = (0.0f64, 0u64);
+    let level = r.mean.mean_rgb().iter().map(|v| v.abs()).sum::<f64>() / 3.0;
     for (((v, m), x), rv) in out
         .variance
         .data
@@ -100,9 +101,11 @@ fn measure(ctx: &Ctx, job: &Job, out: &RenderOutput) -> Row {
             var_sum[c] += v[c];
             rel_var += v[c] / (m[c] * m[c] + ctx.eps);
             // Pixels where neither image varies (background, emitter interiors) carry no
-            // information; the cached reference is stored in f32, so its rounding (relative
-            // 6e-8) is part of the noise, or exact pixels would give z^2 = 1e40.
-            let var = v[c] + rv[c] + (1e-7 * m[c].abs().max(x[c].abs())).powi(2);
+            // information. The cached reference is stored in f32, so its rounding (relative
+            // 6e-8) is part of the noise, and differences below 1e-9 of the image's level are
+            // immaterial; without these floors near-exact pixels give z^2 = 1e40.
+            let floor = 1e-7 * m[c].abs().max(x[c].abs()) + 1e-9 * level;
+            let var = v[c] + rv[c] + floor * floor;
             if out.spp > 1 && v[c] + rv[c] > 0.0 {
                 z2 += (x[c] - m[c]).powi(2) / var;
                 z2_n += 1;

@@ -127,6 +127,19 @@ pub fn colour_bar(title: &str, s: &LogScale) -> Panel {
 }
 
 const PAD: u32 = 8;
+/// Width of a character at the panels' 13 px text size, generously rounded up.
+const CHAR_W: u32 = 7;
+
+/// Shortens `t` to about `width` pixels so it does not run into the next panel's text.
+fn fit_text(t: &str, width: u32) -> String {
+    let max = (width / CHAR_W) as usize;
+    if t.chars().count() <= max || max < 2 {
+        return t.to_string();
+    }
+    let mut s: String = t.chars().take(max - 1).collect();
+    s.push('…');
+    s
+}
 const TEXT: u32 = 20;
 
 /// Rows of panels under a title, written as PNG.
@@ -149,8 +162,8 @@ pub fn write_figure(path: &Path, title: &str, rows: &[Vec<Panel>]) -> Result<(),
                 buf[dst..dst + (p.w * 3) as usize]
                     .copy_from_slice(&p.rgb[src..src + (p.w * 3) as usize]);
             }
-            texts.push((p.title.clone(), x, y + 3));
-            texts.push((p.caption.clone(), x, y + TEXT + p.h + 3));
+            texts.push((fit_text(&p.title, p.w + PAD), x, y + 3));
+            texts.push((fit_text(&p.caption, p.w + PAD), x, y + TEXT + p.h + 3));
             x += p.w + PAD;
         }
         y += row_h(r);
@@ -196,6 +209,14 @@ mod tests {
         assert_eq!(c.rgb, vec![5, 0, 0, 6, 0, 0]);
         assert_eq!(gradient(100, 10).fit(400).w, 400);
         assert_eq!(gradient(768, 8).fit(400).w, 384);
+    }
+
+    #[test]
+    fn long_titles_are_shortened_to_the_panel() {
+        assert_eq!(fit_text("short", 100), "short");
+        let t = fit_text("a very long title for a small panel", 70);
+        assert_eq!(t.chars().count(), 10);
+        assert!(t.ends_with('…'));
     }
 
     #[test]
