@@ -27,6 +27,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Measure render throughput per strategy and thread count.
     Bench(crate::bench::BenchArgs),
+    /// Stability suite of extreme scenes: finiteness, bias and variance per strategy.
+    Extreme(crate::extreme::ExtremeArgs),
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -246,6 +248,7 @@ pub fn main() -> i32 {
     let r = match &cli.command {
         Command::Render(a) => cmd_render(a),
         Command::Bench(a) => crate::bench::run(a),
+        Command::Extreme(a) => crate::extreme::run(a),
     };
     match r {
         Ok(()) => 0,

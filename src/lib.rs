@@ -9,6 +9,7 @@ pub mod bsdf;
 pub mod camera;
 pub mod cli;
 pub mod emitter;
+pub mod extreme;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
