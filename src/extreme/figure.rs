@@ -72,6 +72,8 @@ pub fn write(path: &Path, rows: &[Row]) -> Result<(), String> {
             .configure_mesh()
             .x_desc("spp")
             .y_desc("relMSE")
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .y_label_formatter(&|y| format!("{y:.0e}"))
             .label_style((FONT, 12))
             .draw()
             .map_err(|x| e(&x))?;
