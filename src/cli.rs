@@ -34,6 +34,8 @@ pub enum Command {
     /// Chi-square tests of every sampling routine against its pdf (warps, BSDFs, emitters),
     /// with heat maps; exits non-zero if any case fails.
     Chi2(crate::chi2cases::command::Chi2Args),
+    /// Stability suite of extreme scenes: finiteness, bias and variance per strategy.
+    Extreme(crate::extreme::ExtremeArgs),
 }
 
 /// Options shared by `run` and `reproduce`.
@@ -349,6 +351,7 @@ pub fn main() -> i32 {
             ok.then_some(())
                 .ok_or_else(|| "some sampling routines do not match their pdfs".to_string())
         }),
+        Command::Extreme(a) => crate::extreme::run(a),
     };
     match r {
         Ok(()) => 0,

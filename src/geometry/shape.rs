@@ -9,9 +9,10 @@ pub struct Mesh {
     pub positions: Vec<Vec3>,
     pub normals: Option<Vec<Vec3>>,
     pub indices: Vec<[u32; 3]>,
-    /// Per triangle: unit face normal (by winding) and the largest vertex magnitude, the
-    /// error scale of points on it. Precomputed because every hit and light sample needs them.
-    face: Vec<(Vec3, f32)>,
+    /// Per triangle: unit face normal (by winding) and, per component, the largest vertex
+    /// magnitude: the error scale of points on it. Precomputed because every hit and light
+    /// sample needs them.
+    face: Vec<(Vec3, Vec3)>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -41,7 +42,7 @@ impl Mesh {
             .map(|t| {
                 let [a, b, c] = t.map(|i| positions[i as usize]);
                 let n = (b - a).cross(c - a).normalize_or_zero();
-                (n, max_abs(a).max(max_abs(b)).max(max_abs(c)))
+                (n, a.abs().max(b.abs()).max(c.abs()))
             })
             .collect();
         Mesh {
@@ -126,7 +127,7 @@ impl Sphere {
             ns: n,
             shape,
             prim: 0,
-            err_scale: max_abs(self.center) + self.radius,
+            err_scale: self.center.abs() + Vec3::splat(self.radius),
         }
     }
 }
@@ -141,6 +142,8 @@ pub struct WatertightRay {
     o: Vec3A,
     /// (-d_x / d_z, -d_y / d_z, 1 / d_z) in the permuted frame.
     shear: Vec3A,
+    /// The direction, for the f64 re-evaluation of hits too close for the f32 bound.
+    d: Vec3A,
     /// Dominant axis of the direction: which cyclic permutation maps it to z.
     kz: u8,
 }
@@ -164,6 +167,7 @@ impl WatertightRay {
         WatertightRay {
             o: o.into(),
             shear: Vec3A::new(-dp.x / dp.z, -dp.y / dp.z, 1.0 / dp.z),
+            d: d.into(),
             kz,
         }
     }
@@ -208,11 +212,7 @@ impl WatertightRay {
         let t_scaled = u * az + v * bz + w * cz;
         let inv = 1.0 / det;
         let t = t_scaled * inv;
-        if !(t > tmin && t < tmax) {
-            return None;
-        }
-        // pbrt-v4's conservative bound on the rounding error of t: a hit closer than it may be
-        // the ray's own surface, so it is rejected (this is what makes small spawn offsets safe).
+        // pbrt-v4's conservative bound on the rounding error of t.
         let gamma = |n: f32| n * f32::EPSILON * 0.5 / (1.0 - n * f32::EPSILON * 0.5);
         let max_z = az.abs().max(bz.abs()).max(cz.abs());
         let max_x = ax.abs().max(bx.abs()).max(cx.abs());
@@ -224,7 +224,18 @@ impl WatertightRay {
         let max_e = u.abs().max(v.abs()).max(w.abs());
         let delta_t =
             3.0 * (gamma(3.0) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv.abs();
-        if t <= delta_t {
+        // Within delta_t of 0 the hit may be the ray's own surface (this is what makes small
+        // spawn offsets safe); within delta_t of tmin or tmax f32 cannot tell on which side
+        // of the interval it lies (a shadow ray ending 1e-7 short of a light whose vertices
+        // are 1e5 away "hit" that light at t = 0.99). The bound grows with the vertices'
+        // distance from the origin, not with the distance being decided, so both happen at
+        // geometry 1e-6 of the scene apart. f64 shrinks the bound 5e8-fold and decides; the
+        // inside test stays f32's, so shared edges remain watertight.
+        if t <= delta_t || (t - tmin).abs() <= delta_t || (t - tmax).abs() <= delta_t {
+            let t = super::refine::distance_f64(self.o, self.d, self.kz, [v0, v1, v2])?;
+            return (t > tmin as f64 && t < tmax as f64).then_some((t as f32, v * inv, w * inv));
+        }
+        if !(t > tmin && t < tmax) {
             return None;
         }
         Some((t, v * inv, w * inv))

@@ -2,7 +2,6 @@
 //! uses), so a light sample's density is 1 / Omega instead of d^2 / (A cos).
 
 use glam::{DVec3, Vec2, Vec3};
-use std::f64::consts::PI;
 
 /// Below this solid angle the spherical-triangle formulas lose precision, above it the
 /// triangle nearly surrounds the point: pbrt-v4 samples by area in both cases.
@@ -11,9 +10,13 @@ pub const MAX_SOLID_ANGLE: f32 = 6.22;
 
 /// The projected triangle: unit vertex directions, arc normals and corner angles.
 ///
-/// Computed in f64: a triangle seen nearly edge-on (a sliver along the horizon of a point
-/// 1e-3 from a light's edge) has corner angles within 1e-6 of 0 and pi, and in f32 about 1.5 %
-/// of its samples landed outside it (found by `directlab chi2 emitter/quad-solid-angle-close`).
+/// Computed in f64. Two defects showed the need: a triangle seen nearly edge-on (a sliver
+/// along the horizon of a point 1e-3 from a light's edge) has corner angles within 1e-6 of 0
+/// and pi, and in f32 about 1.5 % of its samples landed outside it (`directlab chi2
+/// emitter/quad-solid-angle-close`); and an arc between two nearly opposite directions (a
+/// receiver under the edge of a light 1e-6 away) has its plane normal computed from
+/// cancelling products, which in f32 tilted the arc by degrees (`directlab extreme`).
+/// The f32 vertices and point are exact in f64.
 struct SphericalTriangle {
     a: DVec3,
     b: DVec3,
@@ -26,7 +29,7 @@ struct SphericalTriangle {
 fn angle_between(u: DVec3, v: DVec3) -> f64 {
     // Numerically better than acos(dot) near 0 and pi.
     if u.dot(v) < 0.0 {
-        PI - 2.0 * ((u + v).length() * 0.5).clamp(-1.0, 1.0).asin()
+        std::f64::consts::PI - 2.0 * ((u + v).length() * 0.5).clamp(-1.0, 1.0).asin()
     } else {
         2.0 * ((v - u).length() * 0.5).clamp(-1.0, 1.0).asin()
     }
@@ -45,7 +48,7 @@ impl SphericalTriangle {
         let alpha = angle_between(n_ab, -n_ca);
         let beta = angle_between(n_bc, -n_ab);
         let gamma = angle_between(n_ca, -n_bc);
-        let area = alpha + beta + gamma - PI;
+        let area = alpha + beta + gamma - std::f64::consts::PI;
         if !(area > 0.0) {
             return None;
         }
@@ -76,15 +79,15 @@ pub fn use_solid_angle(area: f32) -> bool {
 #[inline]
 pub fn sample_spherical_triangle(p: Vec3, v: [Vec3; 3], u: Vec2) -> Option<(Vec3, f32)> {
     let t = SphericalTriangle::new(p, v)?;
-    let area32 = t.area as f32;
-    if !use_solid_angle(area32) {
+    let area = t.area as f32;
+    if !use_solid_angle(area) {
         return None;
     }
     let (a, b, c, alpha) = (t.a, t.b, t.c, t.alpha);
     let (ux, uy) = (u.x as f64, u.y as f64);
     // Choose the sub-triangle area, then the point c' on arc ac that produces it.
     // phi = (A' + pi) - alpha, with A' the sub-triangle's area.
-    let (sin_phi, cos_phi) = (PI + ux * t.area - alpha).sin_cos();
+    let (sin_phi, cos_phi) = (std::f64::consts::PI + ux * t.area - alpha).sin_cos();
     let (sin_alpha, cos_alpha) = alpha.sin_cos();
     let cos_c = a.dot(b);
     let k1 = cos_phi + cos_alpha;
@@ -103,7 +106,7 @@ pub fn sample_spherical_triangle(p: Vec3, v: [Vec3; 3], u: Vec2) -> Option<(Vec3
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
     let cp_perp = (cp - b * cp.dot(b)).try_normalize().unwrap_or(DVec3::ZERO);
     let w = (b * cos_theta + cp_perp * sin_theta).try_normalize()?;
-    Some((w.as_vec3(), 1.0 / area32))
+    Some((w.as_vec3(), 1.0 / area))
 }
 
 /// Barycentrics (b1, b2) where the ray p + t w meets the triangle's plane, clamped into the
@@ -158,6 +161,16 @@ mod tests {
                     Vec3::new(0.0, 0.0, 0.5),
                     Vec3::new(3.0, 0.0, 0.4),
                     Vec3::new(0.0, 2.0, 0.1),
+                ],
+            ),
+            // Under the diagonal of a square light 1e-6 above: the arc between two nearly
+            // opposite directions (f32 tilted it by degrees).
+            (
+                Vec3::ZERO,
+                [
+                    Vec3::new(-0.5, -0.5, 1e-6),
+                    Vec3::new(-0.5, 0.5, 1e-6),
+                    Vec3::new(0.5, 0.5, 1e-6),
                 ],
             ),
             (
