@@ -94,11 +94,11 @@ fn viewpoints(kind: &str) -> Vec<(&'static str, Vec3)> {
     let (close, grazing) = match kind {
         "triangle" => (
             edge_view(v(0.5, -0.3, 0.0), v(0.1, 0.5, 0.0), v(-0.5, -0.4, 0.0)),
-            v(2.0, 0.2, 0.02),
+            Some(v(2.0, 0.2, 0.02)),
         ),
         "quad" => (
             edge_view(v(0.5, -0.5, 0.0), v(0.5, 0.5, 0.0), v(-0.5, 0.5, 0.0)),
-            v(2.0, 0.2, 0.02),
+            Some(v(2.0, 0.2, 0.02)),
         ),
         // Triangle [0, 2, 3], the largest, seen at cos(theta) 0.01 along its own plane; the
         // others then face away.
@@ -106,18 +106,21 @@ fn viewpoints(kind: &str) -> Vec<(&'static str, Vec3)> {
             let (a, b, c) = (m[0], m[2], m[3]);
             let n = (b - a).cross(c - a).normalize();
             let t = n.cross(Vec3::Y).normalize();
-            (edge_view(c, a, b), (a + b + c) / 3.0 + t * 2.0 + n * 0.02)
+            (
+                edge_view(c, a, b),
+                Some((a + b + c) / 3.0 + t * 2.0 + n * 0.02),
+            )
         }
         // A sphere looks the same from every side: it has no grazing view.
-        _ => (v(0.0, 0.0, 0.501), Vec3::NAN),
+        _ => (v(0.0, 0.0, 0.501), None),
     };
     let mut pts = vec![
         ("head-on", v(0.05, 0.03, 1.0)),
         ("close", close),
         ("far", v(20.0, 10.0, 1000.0)),
     ];
-    if grazing.is_finite() {
-        pts.insert(1, ("grazing", grazing));
+    if let Some(g) = grazing {
+        pts.insert(1, ("grazing", g));
     }
     pts
 }
