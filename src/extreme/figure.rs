@@ -1,6 +1,7 @@
 //! The report's figure: relMSE against spp per strategy, for the stiffest cases.
 
 use super::Row;
+use crate::plot::{register_font, series_colour, FONT};
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -13,33 +14,6 @@ pub const PANELS: [&str; 6] = [
     "alpha-1-small-light",
     "4096-emitters",
 ];
-
-const FONT: &str = "sans-serif";
-
-/// plotters' ab_glyph backend has no system font lookup: register the bundled DejaVu Sans
-/// once (the experiment runner's `plot::register_font` does the same under the same name).
-fn register_font() {
-    static ONCE: std::sync::Once = std::sync::Once::new();
-    ONCE.call_once(|| {
-        plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular())
-            .unwrap_or_else(|_| panic!("bundled DejaVu Sans is a valid font"));
-    });
-}
-
-fn colour(i: usize) -> RGBColor {
-    const C: [(u8, u8, u8); 8] = [
-        (31, 119, 180),
-        (255, 127, 14),
-        (44, 160, 44),
-        (214, 39, 40),
-        (148, 103, 189),
-        (140, 86, 75),
-        (227, 119, 194),
-        (127, 127, 127),
-    ];
-    let (r, g, b) = C[i % C.len()];
-    RGBColor(r, g, b)
-}
 
 pub fn write(path: &Path, rows: &[Row]) -> Result<(), String> {
     register_font();
@@ -78,7 +52,7 @@ pub fn write(path: &Path, rows: &[Row]) -> Result<(), String> {
             .draw()
             .map_err(|x| e(&x))?;
         for (i, r) in series.iter().enumerate() {
-            let c = colour(i);
+            let c = series_colour(i);
             let data: Vec<(f64, f64)> =
                 r.m.curve
                     .iter()
