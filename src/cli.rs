@@ -29,6 +29,13 @@ pub enum Command {
     Run(RunArgs),
     /// Run the study's figures (experiments fig1, fig2, fig3) and write their reports.
     Reproduce(ReproduceArgs),
+    /// Measure render throughput per strategy and thread count.
+    Bench(crate::bench::BenchArgs),
+    /// Chi-square tests of every sampling routine against its pdf (warps, BSDFs, emitters),
+    /// with heat maps; exits non-zero if any case fails.
+    Chi2(crate::chi2cases::command::Chi2Args),
+    /// Stability suite of extreme scenes: finiteness, bias and variance per strategy.
+    Extreme(crate::extreme::ExtremeArgs),
 }
 
 /// Options shared by `run` and `reproduce`.
@@ -339,6 +346,12 @@ pub fn main() -> i32 {
         Command::Render(a) => cmd_render(a),
         Command::Run(a) => cmd_run(a),
         Command::Reproduce(a) => cmd_reproduce(a),
+        Command::Bench(a) => crate::bench::run(a),
+        Command::Chi2(a) => crate::chi2cases::command::run(a).and_then(|ok| {
+            ok.then_some(())
+                .ok_or_else(|| "some sampling routines do not match their pdfs".to_string())
+        }),
+        Command::Extreme(a) => crate::extreme::run(a),
     };
     match r {
         Ok(()) => 0,

@@ -4,11 +4,14 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analytic;
+pub mod bench;
 pub mod bsdf;
 pub mod camera;
+pub mod chi2cases;
 pub mod cli;
 pub mod emitter;
 pub mod experiment;
+pub mod extreme;
 pub mod film;
 pub mod geometry;
 pub mod integrator;

@@ -51,17 +51,23 @@ pub fn max_abs(p: Vec3) -> f32 {
 }
 
 /// Offset, relative to a point's error scale, that moves a spawned ray's origin clear of its
-/// own surface. A point recomputed from barycentrics is off by at most gamma(7) ~ 4.2e-7 of
-/// its vertices' magnitude per component (pbrt-v4's bound), so at most sqrt(3) times that
-/// along the normal; 2^-19 (1.9e-6) covers it 2.6 times over. The triangle test itself
-/// rejects hits within its own error bound on t, so the offset need not cover that too.
+/// own surface. A point recomputed from barycentrics is off in component c by at most
+/// gamma(7) ~ 4.2e-7 of its vertices' largest |c| (pbrt-v4's bound), so along the unit
+/// normal n by at most gamma(7) dot(|n|, err_scale); 2^-19 (1.9e-6) covers it 2.6 times over.
+/// The triangle test itself rejects hits within its own error bound on t, so the offset need
+/// not cover that too.
 pub const SPAWN_REL_OFFSET: f32 = 1.0 / 524_288.0;
 
-/// Origin for a ray leaving `p` (geometric normal `ng`, position error scale `err_scale`)
-/// towards direction `d`.
+/// Origin for a ray leaving `p` (geometric normal `ng`, per-component position error scale
+/// `err_scale`) towards direction `d`.
+///
+/// The bound is taken per component, as pbrt's, not as one scalar for the whole point: a
+/// floor at z = 0 has no error in z however wide it is, so its rays start at z ~ 0 and a
+/// light 1e-6 above it is still above their origin (a scalar bound of the floor's size put
+/// the origin beyond such a light, and BSDF samples never reached it).
 #[inline]
-pub fn offset_origin(p: Vec3, ng: Vec3, err_scale: f32, d: Vec3) -> Vec3 {
-    let delta = (err_scale * SPAWN_REL_OFFSET).max(f32::MIN_POSITIVE);
+pub fn offset_origin(p: Vec3, ng: Vec3, err_scale: Vec3, d: Vec3) -> Vec3 {
+    let delta = (ng.abs().dot(err_scale) * SPAWN_REL_OFFSET).max(f32::MIN_POSITIVE);
     let off = ng * delta;
     if d.dot(ng) >= 0.0 {
         p + off

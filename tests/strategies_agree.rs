@@ -3,51 +3,12 @@
 //! channels, independent seeds) by z-tests at family-wise alpha = 1e-3, Sidak-corrected over
 //! regions, channels and strategies.
 
-use directlab::emitter::{EmitterSelection, LightSampling};
 use directlab::integrator::Strategy;
 use directlab::metrics::compare_regions;
 use directlab::render::{render, RenderOutput, RenderSettings};
 use directlab::scene::desc::{Heuristic, StrategyKind};
 use directlab::scene::{load_scene, Scene};
 use std::path::Path;
-
-fn strategies() -> Vec<Strategy> {
-    let mut v = Vec::new();
-    for selection in [EmitterSelection::Uniform, EmitterSelection::Power] {
-        for light_sampling in [LightSampling::Area, LightSampling::SolidAngle] {
-            let s = Strategy {
-                kind: StrategyKind::Light,
-                heuristic: Heuristic::Balance,
-                emitter_samples: 1,
-                bsdf_samples: 1,
-                selection,
-                light_sampling,
-                hide_emitters: false,
-            };
-            v.push(s);
-            v.push(Strategy {
-                kind: StrategyKind::Mis,
-                ..s
-            });
-            v.push(Strategy {
-                kind: StrategyKind::Mis,
-                heuristic: Heuristic::Power,
-                emitter_samples: 2,
-                ..s
-            });
-            v.push(Strategy {
-                kind: StrategyKind::MisOneSample,
-                heuristic: Heuristic::Power,
-                ..s
-            });
-        }
-    }
-    v.push(Strategy {
-        kind: StrategyKind::Bsdf,
-        ..v[0]
-    });
-    v
-}
 
 fn render_with(scene: &Scene, s: Strategy, spp: u32, seed: u64) -> RenderOutput {
     render(
@@ -70,7 +31,7 @@ fn check_scene(path: &str, spp: u32) {
     reference.kind = StrategyKind::Mis;
     reference.heuristic = Heuristic::Power;
     let base = render_with(&scene, reference, spp, 1000);
-    let all = strategies();
+    let all = Strategy::combinations();
     let alpha = 1.0 - (1.0 - 1e-3f64).powf(1.0 / all.len() as f64);
     for (i, s) in all.iter().enumerate() {
         // BSDF sampling alone finds small lights rarely: more samples keep its noise (and the

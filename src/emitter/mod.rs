@@ -25,7 +25,7 @@ pub struct LightSample {
     /// Point on the light, its geometric normal and error scale (for the shadow ray's end).
     pub p: Vec3,
     pub ng: Vec3,
-    pub err_scale: f32,
+    pub err_scale: Vec3,
     /// Unit direction from the reference point to `p`, and the distance.
     pub wi: Vec3,
     pub dist: f32,
@@ -84,7 +84,7 @@ impl Emitter {
                 Some(LightSample {
                     p: pl.position,
                     ng: -d / dist,
-                    err_scale: 0.0,
+                    err_scale: Vec3::ZERO,
                     wi: d / dist,
                     dist,
                     li: pl.intensity / dist2,

@@ -9,7 +9,7 @@ use std::time::Duration;
 /// Primitive data stored in BVH leaf order, so the traversal callback indexes it directly.
 #[derive(Clone, Copy, Debug)]
 enum Prim {
-    Tri { v: [Vec3; 3] },
+    Tri { v: [Vec3A; 3] },
     Sphere { c: Vec3, r: f32 },
 }
 
@@ -51,10 +51,10 @@ impl Accel {
                         if (b - a).cross(c - a).length_squared() == 0.0 {
                             continue;
                         }
-                        let (a, b, c) = (a * scale, b * scale, c * scale);
-                        prims.push(Prim::Tri { v: [a, b, c] });
+                        let v = [a, b, c].map(|p| Vec3A::from(p * scale));
+                        prims.push(Prim::Tri { v });
                         refs.push((si as u32, ti as u32));
-                        aabbs.push(Aabb::from_points(&[a.into(), b.into(), c.into()]));
+                        aabbs.push(Aabb::from_points(&v));
                     }
                 }
                 ShapeKind::Sphere(s) => {
@@ -100,16 +100,31 @@ impl Accel {
         self.prims.len()
     }
 
+    /// Distance to primitive `i` (infinite on a miss) and, for triangles, barycentrics.
     #[inline(always)]
-    fn prim_t(&self, i: usize, wr: &WatertightRay, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> f32 {
+    fn prim_hit(
+        &self,
+        i: usize,
+        wr: &WatertightRay,
+        o: Vec3,
+        d: Vec3,
+        tmin: f32,
+        tmax: f32,
+    ) -> (f32, Vec2) {
         match self.prims[i] {
             Prim::Tri { v: [a, b, c] } => wr
                 .intersect(a, b, c, tmin, tmax)
-                .map_or(f32::INFINITY, |h| h.0),
-            Prim::Sphere { c, r } => {
-                intersect_sphere(o, d, tmin, tmax, c, r).unwrap_or(f32::INFINITY)
-            }
+                .map_or((f32::INFINITY, Vec2::ZERO), |h| (h.0, Vec2::new(h.1, h.2))),
+            Prim::Sphere { c, r } => (
+                intersect_sphere(o, d, tmin, tmax, c, r).unwrap_or(f32::INFINITY),
+                Vec2::ZERO,
+            ),
         }
+    }
+
+    #[inline(always)]
+    fn prim_t(&self, i: usize, wr: &WatertightRay, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> f32 {
+        self.prim_hit(i, wr, o, d, tmin, tmax).0
     }
 
     /// Closest hit within the ray's interval.
@@ -120,24 +135,23 @@ impl Accel {
         let r = obvhs::ray::Ray::new(o.into(), d.into(), tmin, ray.tmax * k);
         let mut hit = RayHit::none();
         let wr = WatertightRay::new(o, d);
-        let found = bvh.ray_traverse(r, &mut hit, |r, i| self.prim_t(i, &wr, o, d, tmin, r.tmax));
+        // obvhs keeps the closest t; the barycentrics of the current best ride along.
+        let mut best_bary = Vec2::ZERO;
+        let found = bvh.ray_traverse(r, &mut hit, |r, i| {
+            let (t, bary) = self.prim_hit(i, &wr, o, d, tmin, r.tmax);
+            if t < r.tmax {
+                best_bary = bary;
+            }
+            t
+        });
         if !found {
             return None;
         }
         let i = hit.primitive_id as usize;
         let (shape, local) = self.refs[i];
-        let sp = match (self.prims[i], &shapes[shape as usize].kind) {
-            (Prim::Tri { v: [a, b, c] }, ShapeKind::Mesh(m)) => {
-                // Recompute barycentrics for the winner only, not inside the traversal.
-                let (_, u, v) = wr
-                    .intersect(a, b, c, f32::NEG_INFINITY, f32::INFINITY)
-                    .unwrap_or((hit.t, 1.0 / 3.0, 1.0 / 3.0));
-                m.surface_point(local as usize, Vec2::new(u, v), shape)
-            }
-            (Prim::Sphere { .. }, ShapeKind::Sphere(s)) => {
-                s.surface_point(ray.o + ray.d * (hit.t / k), shape)
-            }
-            _ => unreachable!("primitive and shape kinds always agree"),
+        let sp = match &shapes[shape as usize].kind {
+            ShapeKind::Mesh(m) => m.surface_point(local as usize, best_bary, shape),
+            ShapeKind::Sphere(s) => s.surface_point(ray.o + ray.d * (hit.t / k), shape),
         };
         Some(Hit { t: hit.t / k, sp })
     }
@@ -178,11 +192,7 @@ mod tests {
             }
         }
         Shape {
-            kind: ShapeKind::Mesh(Mesh {
-                positions,
-                normals: None,
-                indices,
-            }),
+            kind: ShapeKind::Mesh(Mesh::new(positions, None, indices)),
             material: 0,
             emitter: None,
         }

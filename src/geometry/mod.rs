@@ -1,6 +1,7 @@
 //! Geometry: shapes in world space, their intersection, and the BVH over all of them.
 
 pub mod accel;
+mod refine;
 pub mod shape;
 
 pub use accel::Accel;
@@ -39,9 +40,9 @@ pub struct SurfacePoint {
     pub shape: u32,
     /// Triangle index within the shape (0 for spheres).
     pub prim: u32,
-    /// Magnitude of the values `p` was computed from (vertices, sphere centre and radius):
-    /// its rounding error is proportional to this, not to |p|.
-    pub err_scale: f32,
+    /// Per component, the magnitude of the values `p` was computed from (vertices, sphere
+    /// centre and radius): its rounding error is proportional to this, not to |p|.
+    pub err_scale: Vec3,
 }
 
 impl SurfacePoint {

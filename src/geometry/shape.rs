@@ -2,13 +2,17 @@
 
 use super::SurfacePoint;
 use crate::math::{max_abs, PI};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3A, Vec3Swizzles};
 
 #[derive(Clone, Debug)]
 pub struct Mesh {
     pub positions: Vec<Vec3>,
     pub normals: Option<Vec<Vec3>>,
     pub indices: Vec<[u32; 3]>,
+    /// Per triangle: unit face normal (by winding) and, per component, the largest vertex
+    /// magnitude: the error scale of points on it. Precomputed because every hit and light
+    /// sample needs them.
+    face: Vec<(Vec3, Vec3)>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -32,6 +36,23 @@ pub struct Shape {
 }
 
 impl Mesh {
+    pub fn new(positions: Vec<Vec3>, normals: Option<Vec<Vec3>>, indices: Vec<[u32; 3]>) -> Self {
+        let face = indices
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| positions[i as usize]);
+                let n = (b - a).cross(c - a).normalize_or_zero();
+                (n, a.abs().max(b.abs()).max(c.abs()))
+            })
+            .collect();
+        Mesh {
+            positions,
+            normals,
+            indices,
+            face,
+        }
+    }
+
     #[inline]
     pub fn vertices(&self, tri: usize) -> [Vec3; 3] {
         let [a, b, c] = self.indices[tri];
@@ -55,7 +76,7 @@ impl Mesh {
         let [a, v1, v2] = self.vertices(tri);
         let b0 = 1.0 - b.x - b.y;
         let p = a * b0 + v1 * b.x + v2 * b.y;
-        let ng = (v1 - a).cross(v2 - a).normalize_or_zero();
+        let (ng, err_scale) = self.face[tri];
         let mut ns = ng;
         let mut ngo = ng;
         if let Some(normals) = &self.normals {
@@ -70,7 +91,6 @@ impl Mesh {
                 }
             }
         }
-        let err_scale = b0.abs() * max_abs(a) + b.x.abs() * max_abs(v1) + b.y.abs() * max_abs(v2);
         SurfacePoint {
             p,
             ng: ngo,
@@ -107,19 +127,25 @@ impl Sphere {
             ns: n,
             shape,
             prim: 0,
-            err_scale: max_abs(self.center) + self.radius,
+            err_scale: self.center.abs() + Vec3::splat(self.radius),
         }
     }
 }
 
 /// Per-ray setup of the watertight ray-triangle test (Woop, Benthin and Wald 2013): the ray
 /// is mapped to +z by a permutation and shear, so neighbouring triangles evaluate their
-/// shared edge with identical arithmetic and no ray slips between them.
+/// shared edge with identical arithmetic and no ray slips between them. (The paper also swaps
+/// x and y when d.z < 0 to keep the determinant's sign for back-face culling; without culling
+/// that swap changes neither t nor the barycentrics.)
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
-    o: Vec3,
-    k: [usize; 3],
-    shear: Vec3,
+    o: Vec3A,
+    /// (-d_x / d_z, -d_y / d_z, 1 / d_z) in the permuted frame.
+    shear: Vec3A,
+    /// The direction, for the f64 re-evaluation of hits too close for the f32 bound.
+    d: Vec3A,
+    /// Dominant axis of the direction: which cyclic permutation maps it to z.
+    kz: u8,
 }
 
 impl WatertightRay {
@@ -137,17 +163,12 @@ impl WatertightRay {
         } else {
             2
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        // Keep the winding (and so the sign of the determinant) of the original triangle.
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let dz = d[kz];
+        let dp = permute(d.into(), kz);
         WatertightRay {
-            o,
-            k: [kx, ky, kz],
-            shear: Vec3::new(-d[kx] / dz, -d[ky] / dz, 1.0 / dz),
+            o: o.into(),
+            shear: Vec3A::new(-dp.x / dp.z, -dp.y / dp.z, 1.0 / dp.z),
+            d: d.into(),
+            kz,
         }
     }
 
@@ -155,18 +176,19 @@ impl WatertightRay {
     #[inline(always)]
     pub fn intersect(
         &self,
-        v0: Vec3,
-        v1: Vec3,
-        v2: Vec3,
+        v0: Vec3A,
+        v1: Vec3A,
+        v2: Vec3A,
         tmin: f32,
         tmax: f32,
     ) -> Option<(f32, f32, f32)> {
-        let [kx, ky, kz] = self.k;
-        let (a, b, c) = (v0 - self.o, v1 - self.o, v2 - self.o);
+        let a = permute(v0 - self.o, self.kz);
+        let b = permute(v1 - self.o, self.kz);
+        let c = permute(v2 - self.o, self.kz);
         let (sx, sy) = (self.shear.x, self.shear.y);
-        let (ax, ay) = (a[kx] + sx * a[kz], a[ky] + sy * a[kz]);
-        let (bx, by) = (b[kx] + sx * b[kz], b[ky] + sy * b[kz]);
-        let (cx, cy) = (c[kx] + sx * c[kz], c[ky] + sy * c[kz]);
+        let (ax, ay) = (a.x + sx * a.z, a.y + sy * a.z);
+        let (bx, by) = (b.x + sx * b.z, b.y + sy * b.z);
+        let (cx, cy) = (c.x + sx * c.z, c.y + sy * c.z);
         let mut u = cx * by - cy * bx;
         let mut v = ax * cy - ay * cx;
         let mut w = bx * ay - by * ax;
@@ -186,15 +208,11 @@ impl WatertightRay {
             return None;
         }
         let sz = self.shear.z;
-        let (az, bz, cz) = (sz * a[kz], sz * b[kz], sz * c[kz]);
+        let (az, bz, cz) = (sz * a.z, sz * b.z, sz * c.z);
         let t_scaled = u * az + v * bz + w * cz;
         let inv = 1.0 / det;
         let t = t_scaled * inv;
-        if !(t > tmin && t < tmax) {
-            return None;
-        }
-        // pbrt-v4's conservative bound on the rounding error of t: a hit closer than it may be
-        // the ray's own surface, so it is rejected (this is what makes small spawn offsets safe).
+        // pbrt-v4's conservative bound on the rounding error of t.
         let gamma = |n: f32| n * f32::EPSILON * 0.5 / (1.0 - n * f32::EPSILON * 0.5);
         let max_z = az.abs().max(bz.abs()).max(cz.abs());
         let max_x = ax.abs().max(bx.abs()).max(cx.abs());
@@ -206,10 +224,31 @@ impl WatertightRay {
         let max_e = u.abs().max(v.abs()).max(w.abs());
         let delta_t =
             3.0 * (gamma(3.0) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv.abs();
-        if t <= delta_t {
+        // Within delta_t of 0 the hit may be the ray's own surface (this is what makes small
+        // spawn offsets safe); within delta_t of tmin or tmax f32 cannot tell on which side
+        // of the interval it lies (a shadow ray ending 1e-7 short of a light whose vertices
+        // are 1e5 away "hit" that light at t = 0.99). The bound grows with the vertices'
+        // distance from the origin, not with the distance being decided, so both happen at
+        // geometry 1e-6 of the scene apart. f64 shrinks the bound 5e8-fold and decides; the
+        // inside test stays f32's, so shared edges remain watertight.
+        if t <= delta_t || (t - tmin).abs() <= delta_t || (t - tmax).abs() <= delta_t {
+            let t = super::refine::distance_f64(self.o, self.d, self.kz, [v0, v1, v2])?;
+            return (t > tmin as f64 && t < tmax as f64).then_some((t as f32, v * inv, w * inv));
+        }
+        if !(t > tmin && t < tmax) {
             return None;
         }
         Some((t, v * inv, w * inv))
+    }
+}
+
+/// The cyclic permutation that moves axis `kz` to z.
+#[inline(always)]
+fn permute(v: Vec3A, kz: u8) -> Vec3A {
+    match kz {
+        0 => v.yzx(),
+        1 => v.zxy(),
+        _ => v,
     }
 }
 
@@ -222,7 +261,7 @@ pub fn intersect_triangle(
     tmax: f32,
     v: [Vec3; 3],
 ) -> Option<(f32, f32, f32)> {
-    WatertightRay::new(o, d).intersect(v[0], v[1], v[2], tmin, tmax)
+    WatertightRay::new(o, d).intersect(v[0].into(), v[1].into(), v[2].into(), tmin, tmax)
 }
 
 /// Nearest root of |o + t d - c| = r inside (tmin, tmax). The discriminant is computed from
@@ -331,11 +370,11 @@ mod tests {
 
     #[test]
     fn interpolated_normal_uses_all_three_vertices() {
-        let m = Mesh {
-            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
-            normals: Some(vec![Vec3::Z, Vec3::new(1.0, 0.0, 1.0).normalize(), Vec3::Z]),
-            indices: vec![[0, 1, 2]],
-        };
+        let m = Mesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            Some(vec![Vec3::Z, Vec3::new(1.0, 0.0, 1.0).normalize(), Vec3::Z]),
+            vec![[0, 1, 2]],
+        );
         let a = m.surface_point(0, Vec2::new(0.0, 0.0), 0).ns;
         let b = m.surface_point(0, Vec2::new(0.5, 0.0), 0).ns;
         assert!((a - Vec3::Z).length() < 1e-6);

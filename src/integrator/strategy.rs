@@ -29,6 +29,56 @@ impl Strategy {
         }
     }
 
+    /// One of each kind of estimator (light, BSDF, balance and power MIS with 1 or 2 light
+    /// samples, one-sample MIS) for every emitter choice and light sampling mode: the set the
+    /// tests run to show that all strategies estimate the same image.
+    pub fn combinations() -> Vec<Strategy> {
+        let mut v = Vec::new();
+        for selection in [EmitterSelection::Uniform, EmitterSelection::Power] {
+            for light_sampling in [LightSampling::Area, LightSampling::SolidAngle] {
+                let base = Strategy {
+                    kind: StrategyKind::Light,
+                    heuristic: Heuristic::Balance,
+                    emitter_samples: 1,
+                    bsdf_samples: 1,
+                    selection,
+                    light_sampling,
+                    hide_emitters: false,
+                };
+                v.push(base);
+                v.push(Strategy {
+                    kind: StrategyKind::Mis,
+                    ..base
+                });
+                v.push(Strategy {
+                    kind: StrategyKind::Mis,
+                    heuristic: Heuristic::Power,
+                    emitter_samples: 2,
+                    ..base
+                });
+                v.push(Strategy {
+                    kind: StrategyKind::MisOneSample,
+                    ..base
+                });
+                v.push(Strategy {
+                    kind: StrategyKind::MisOneSample,
+                    heuristic: Heuristic::Power,
+                    ..base
+                });
+            }
+        }
+        v.push(Strategy {
+            kind: StrategyKind::Bsdf,
+            ..v[0]
+        });
+        v.push(Strategy {
+            kind: StrategyKind::Bsdf,
+            bsdf_samples: 3,
+            ..v[0]
+        });
+        v
+    }
+
     /// Stable label for file names, CSV rows and plot legends, e.g. `mis-power-e1b1-uni-area`.
     pub fn label(&self) -> String {
         let sel = match self.selection {

@@ -8,9 +8,9 @@
 //! defects these tests exist for give |z| of 10 to 100+.
 
 use super::Strategy;
-use crate::emitter::{EmitterSelection, LightSampling};
+use crate::emitter::EmitterSelection;
 use crate::render::{render, RenderOutput, RenderSettings};
-use crate::scene::desc::{Heuristic, StrategyKind};
+use crate::scene::desc::StrategyKind;
 use crate::scene::{fixtures, Scene};
 use glam::Vec3;
 use statrs::distribution::{ContinuousCDF, Normal};
@@ -19,50 +19,7 @@ use statrs::distribution::{ContinuousCDF, Normal};
 pub(crate) const ALPHA: f64 = 1e-3;
 
 pub(crate) fn all_strategies() -> Vec<Strategy> {
-    let mut v = Vec::new();
-    for selection in [EmitterSelection::Uniform, EmitterSelection::Power] {
-        for light_sampling in [LightSampling::Area, LightSampling::SolidAngle] {
-            let base = Strategy {
-                kind: StrategyKind::Light,
-                heuristic: Heuristic::Balance,
-                emitter_samples: 1,
-                bsdf_samples: 1,
-                selection,
-                light_sampling,
-                hide_emitters: false,
-            };
-            v.push(base);
-            v.push(Strategy {
-                kind: StrategyKind::Mis,
-                ..base
-            });
-            v.push(Strategy {
-                kind: StrategyKind::Mis,
-                heuristic: Heuristic::Power,
-                emitter_samples: 2,
-                ..base
-            });
-            v.push(Strategy {
-                kind: StrategyKind::MisOneSample,
-                ..base
-            });
-            v.push(Strategy {
-                kind: StrategyKind::MisOneSample,
-                heuristic: Heuristic::Power,
-                ..base
-            });
-        }
-    }
-    v.push(Strategy {
-        kind: StrategyKind::Bsdf,
-        ..v[0]
-    });
-    v.push(Strategy {
-        kind: StrategyKind::Bsdf,
-        bsdf_samples: 3,
-        ..v[0]
-    });
-    v
+    Strategy::combinations()
 }
 
 /// Two-sided critical |z| at level alpha, Sidak-corrected for `m` tests.

@@ -124,10 +124,18 @@ pub fn square_to_cosine_hemisphere_pdf(v: Vec3) -> f32 {
 /// Uniform direction in the cone around +z with the given cos of its half-angle.
 #[inline]
 pub fn square_to_uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
-    let z = 1.0 - u.x * (1.0 - cos_max);
-    let r = (1.0 - z * z).max(0.0).sqrt();
+    square_to_uniform_cone_1m(u, 1.0 - cos_max)
+}
+
+/// [`square_to_uniform_cone`] given `1 - cos(theta_max)`, which for a narrow cone is far more
+/// precise than cos(theta_max) itself: at 1e-7 sr an f32 cos has one or two distinct values
+/// below 1. sin(theta) comes from w = 1 - cos(theta) as sqrt(w (2 - w)), never from 1 - z^2.
+#[inline]
+pub fn square_to_uniform_cone_1m(u: Vec2, one_minus_cos_max: f32) -> Vec3 {
+    let w = u.x * one_minus_cos_max;
+    let r = (w * (2.0 - w)).max(0.0).sqrt();
     let (s, c) = (2.0 * PI * u.y).sin_cos();
-    Vec3::new(r * c, r * s, z)
+    Vec3::new(r * c, r * s, 1.0 - w)
 }
 
 #[inline]

@@ -185,11 +185,11 @@ impl Scene {
                             ),
                         ));
                     }
-                    ShapeKind::Mesh(Mesh {
-                        positions: positions.clone(),
-                        normals: normals.clone(),
-                        indices: indices.clone(),
-                    })
+                    ShapeKind::Mesh(Mesh::new(
+                        positions.clone(),
+                        normals.clone(),
+                        indices.clone(),
+                    ))
                 }
                 ShapeGeometry::Sphere {
                     center,
@@ -289,19 +289,24 @@ impl Scene {
     /// receiver nor the light itself counts as a blocker.
     #[inline]
     pub fn visible(&self, from: &SurfacePoint, ls: &LightSample) -> bool {
+        !self.accel.occluded(&Self::shadow_ray(from, ls))
+    }
+
+    /// The shadow ray `visible` traces (unnormalised direction, t in [0, 1 - 1e-4]).
+    #[inline]
+    pub fn shadow_ray(from: &SurfacePoint, ls: &LightSample) -> Ray {
         let o = from.spawn_origin(ls.p - from.p);
         let target = if ls.delta {
             ls.p
         } else {
             offset_origin(ls.p, ls.ng, ls.err_scale, o - ls.p)
         };
-        let ray = Ray {
+        Ray {
             o,
             d: target - o,
             tmin: 0.0,
             tmax: 1.0 - 1e-4,
-        };
-        !self.accel.occluded(&ray)
+        }
     }
 
     #[inline]

@@ -76,15 +76,22 @@ fn floor(albedo: f32) -> ShapeDesc {
     )
 }
 
-/// A large diffuse floor z = 0 (normal +z) under `light`, seen by a one-pixel camera with a
-/// tiny field of view that looks at the receiver point `x` from `eye`.
-pub fn light_over_floor(light: ShapeDesc, albedo: f32, x: Vec3, eye: Vec3) -> SceneDesc {
+/// A large diffuse floor z = 0 (normal +z), seen by a one-pixel camera with a tiny field of
+/// view that looks at the receiver point `x` from `eye`. Add lights to it.
+pub fn floor_probe(albedo: f32, x: Vec3, eye: Vec3) -> SceneDesc {
     let up = if (eye - x).cross(Vec3::Y).length() > 1e-3 {
         Vec3::Y
     } else {
         Vec3::X
     };
-    base(look_at(eye, x, up), 1e-3, 1, 1, vec![floor(albedo), light])
+    base(look_at(eye, x, up), 1e-3, 1, 1, vec![floor(albedo)])
+}
+
+/// `floor_probe` under one area light.
+pub fn light_over_floor(light: ShapeDesc, albedo: f32, x: Vec3, eye: Vec3) -> SceneDesc {
+    let mut d = floor_probe(albedo, x, eye);
+    d.shapes.push(light);
+    d
 }
 
 /// A one-sided triangle light (emitting towards the side its counter-clockwise winding
@@ -227,6 +234,13 @@ pub fn transform(desc: &mut SceneDesc, m: Mat4) {
     }
     // Clip distances are camera-space depths: the scaled camera matrix scales them already.
     desc.camera.to_world = m * desc.camera.to_world;
+}
+
+/// Just these shapes (and a 1x1 camera that nothing depends on): for testing light sampling
+/// on its own, where no receiver or floor should be in the way.
+pub fn shapes_only(shapes: Vec<ShapeDesc>) -> SceneDesc {
+    let cam = look_at(Vec3::new(0.0, 0.0, -10.0), Vec3::ZERO, Vec3::Y);
+    base(cam, 30.0, 1, 1, shapes)
 }
 
 #[cfg(test)]

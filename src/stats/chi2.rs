@@ -111,6 +111,20 @@ pub fn cell_integrals<D: Domain>(
     pdf: impl Fn(D::Point) -> f64,
     cfg: &Integration,
 ) -> (Grid, u64) {
+    cell_integrals_seen(domain, pdf, cfg, None)
+}
+
+/// [`cell_integrals`], then cells that `observed` says received samples but that integrate
+/// to 0 are integrated again from `recheck_split x recheck_split` rectangles: the corner of
+/// a light seen at a grazing angle is a wedge thinner than any node spacing chosen in
+/// advance, and the samples show where to look. A cell still empty after that is one where
+/// the sampler produced what its pdf calls impossible.
+pub fn cell_integrals_seen<D: Domain>(
+    domain: &D,
+    pdf: impl Fn(D::Point) -> f64,
+    cfg: &Integration,
+    observed: Option<&Grid>,
+) -> (Grid, u64) {
     let (cols, rows) = domain.resolution();
     let ([u0, u1], [v0, v1]) = domain.bounds();
     let (du, dv) = ((u1 - u0) / cols as f64, (v1 - v0) / rows as f64);
@@ -136,6 +150,73 @@ pub fn cell_integrals<D: Domain>(
             let u = [u0 + c as f64 * du, u0 + (c + 1) as f64 * du];
             let v = [v0 + r as f64 * dv, v0 + (r + 1) as f64 * dv];
             grid.data[r * cols + c] = integrate_rect(&mut f, u, v, cfg, abs_tol);
+        }
+    }
+    // Second look at cells on the support's boundary (a 3x3 neighbourhood holding both
+    // empty and non-empty cells) with a finer start and the same finest scale: a sliver's tip
+    // can pass between all nodes of the first pass, leaving its cells empty or underweighted.
+    // An empty cell found non-empty puts its neighbours on the list, following the tip.
+    if cfg.boundary_split > cfg.initial_split.max(1) {
+        let levels = (cfg.boundary_split as f64 / cfg.initial_split.max(1) as f64)
+            .log2()
+            .floor() as u32;
+        let fine = Integration {
+            initial_split: cfg.boundary_split,
+            max_depth: cfg.max_depth.saturating_sub(levels),
+            ..*cfg
+        };
+        let neighbours = |c: usize, r: usize| {
+            let rs = r.saturating_sub(1)..=(r + 1).min(rows - 1);
+            rs.flat_map(move |rr| {
+                (c.saturating_sub(1)..=(c + 1).min(cols - 1)).map(move |cc| (cc, rr))
+            })
+        };
+        let mut todo: Vec<(usize, usize)> = Vec::new();
+        for r in 0..rows {
+            for c in 0..cols {
+                let (mut empty, mut full) = (false, false);
+                for (cc, rr) in neighbours(c, r) {
+                    let x = grid.get(cc, rr);
+                    empty |= x == 0.0;
+                    full |= x > 0.0;
+                }
+                if empty && full {
+                    todo.push((c, r));
+                }
+            }
+        }
+        let mut done = vec![false; cols * rows];
+        while let Some((c, r)) = todo.pop() {
+            if std::mem::replace(&mut done[r * cols + c], true) {
+                continue;
+            }
+            let u = [u0 + c as f64 * du, u0 + (c + 1) as f64 * du];
+            let v = [v0 + r as f64 * dv, v0 + (r + 1) as f64 * dv];
+            let was = grid.data[r * cols + c];
+            let now = integrate_rect(&mut f, u, v, &fine, abs_tol);
+            grid.data[r * cols + c] = now;
+            if was == 0.0 && now > 0.0 {
+                todo.extend(neighbours(c, r).filter(|&(cc, rr)| !done[rr * cols + cc]));
+            }
+        }
+    }
+    if let Some(seen) = observed.filter(|_| cfg.recheck_split > 1) {
+        let levels = (cfg.recheck_split as f64 / cfg.initial_split.max(1) as f64)
+            .log2()
+            .floor() as u32;
+        let fine = Integration {
+            initial_split: cfg.recheck_split,
+            max_depth: cfg.max_depth.saturating_sub(levels),
+            ..*cfg
+        };
+        for r in 0..rows {
+            for c in 0..cols {
+                if grid.get(c, r) == 0.0 && seen.get(c, r) > 0.0 {
+                    let u = [u0 + c as f64 * du, u0 + (c + 1) as f64 * du];
+                    let v = [v0 + r as f64 * dv, v0 + (r + 1) as f64 * dv];
+                    grid.data[r * cols + c] = integrate_rect(&mut f, u, v, &fine, abs_tol);
+                }
+            }
         }
     }
     (grid, bad)
@@ -208,7 +289,7 @@ pub fn chi2_test<D: Domain>(
         }
     }
 
-    let (fractions, bad_pdf) = cell_integrals(domain, &pdf, &cfg.integration);
+    let (fractions, bad_pdf) = cell_integrals_seen(domain, &pdf, &cfg.integration, Some(&observed));
     let pdf_integral = fractions.sum();
     let expected = Grid {
         data: fractions.data.iter().map(|x| x * nf).collect(),

@@ -19,6 +19,15 @@ pub struct Integration {
     pub rel_tol: f64,
     /// Node values differing by more than this factor force refinement.
     pub jump_ratio: f64,
+    /// Cells found empty but next to a non-empty cell are integrated again starting from
+    /// `boundary_split x boundary_split` rectangles: the tip of a sliver (a grazing light's
+    /// far corner) can pass between all nodes of the first pass. 0 (the default) disables
+    /// this; `chi2cases` uses 8.
+    pub boundary_split: usize,
+    /// Cells that received samples but integrate to 0 are integrated again from
+    /// `recheck_split x recheck_split` rectangles before their samples are called
+    /// impossible (see `chi2::cell_integrals_seen`). 0 or 1 disables this.
+    pub recheck_split: usize,
 }
 
 impl Default for Integration {
@@ -28,6 +37,8 @@ impl Default for Integration {
             max_depth: 8,
             rel_tol: 1e-4,
             jump_ratio: 2.0,
+            boundary_split: 0,
+            recheck_split: 64,
         }
     }
 }

@@ -1,0 +1,260 @@
+//! `directlab bench`: speed goals as measured numbers (printed and written to
+//! `reports/bench/bench.csv`), never timed tests. Sections: render throughput per scene,
+//! strategy and thread count; the ray-tracing limit for the same ray mix and the share of
+//! render time spent outside traversal; per-sample cost as the triangle and emitter counts
+//! grow; peak memory.
+
+mod raylimit;
+mod scaling;
+
+use crate::cli::open_scene;
+use crate::emitter::{EmitterSelection, LightSampling};
+use crate::integrator::Strategy;
+use crate::render::{render, RenderSettings};
+use crate::scene::desc::{Heuristic, StrategyKind};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Scenes to measure (default: the bundled Cornell box).
+    #[arg(long = "scene")]
+    pub scenes: Vec<PathBuf>,
+    /// Thread counts to measure.
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    pub threads: Vec<usize>,
+    /// Samples per pixel of each timed render.
+    #[arg(long, default_value_t = 64)]
+    pub spp: u32,
+    /// Image resolution (sets the scene's `res` default).
+    #[arg(long, default_value_t = 256)]
+    pub res: u32,
+    /// Timed repetitions; the fastest is reported (the others measure interference).
+    #[arg(long, default_value_t = 3)]
+    pub repeat: u32,
+    /// Output CSV.
+    #[arg(long, default_value = "reports/bench/bench.csv")]
+    pub out: PathBuf,
+}
+
+/// The strategies whose throughput is reported: the study's and the usual MIS settings.
+pub fn bench_strategies() -> Vec<Strategy> {
+    let base = Strategy {
+        kind: StrategyKind::Mis,
+        heuristic: Heuristic::Power,
+        emitter_samples: 1,
+        bsdf_samples: 1,
+        selection: EmitterSelection::Uniform,
+        light_sampling: LightSampling::Area,
+        hide_emitters: false,
+    };
+    vec![
+        base,
+        Strategy {
+            heuristic: Heuristic::Balance,
+            ..base
+        },
+        Strategy {
+            kind: StrategyKind::Light,
+            ..base
+        },
+        Strategy {
+            kind: StrategyKind::Bsdf,
+            ..base
+        },
+        Strategy {
+            kind: StrategyKind::MisOneSample,
+            ..base
+        },
+        Strategy {
+            light_sampling: LightSampling::SolidAngle,
+            ..base
+        },
+        Strategy {
+            selection: EmitterSelection::Power,
+            ..base
+        },
+    ]
+}
+
+/// One measurement. `section` says what it measures; `n` is the swept size where one is.
+#[derive(serde::Serialize)]
+struct Row {
+    section: &'static str,
+    scene: String,
+    strategy: String,
+    threads: usize,
+    n: u64,
+    value: f64,
+    unit: &'static str,
+}
+
+/// Camera samples per second of `spp` samples per pixel, best of `repeat`.
+fn throughput(
+    scene: &crate::scene::Scene,
+    strategy: Strategy,
+    spp: u32,
+    threads: usize,
+    repeat: u32,
+) -> f64 {
+    let settings = RenderSettings {
+        spp,
+        seed: 1,
+        threads: Some(threads),
+        progress: false,
+    };
+    let best = (0..repeat.max(1))
+        .map(|_| render(scene, strategy, &settings).seconds)
+        .fold(f64::INFINITY, f64::min);
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    w as f64 * h as f64 * spp as f64 / best
+}
+
+/// Peak resident memory of this process in bytes (Linux), if known.
+fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+pub fn run(a: &BenchArgs) -> Result<(), String> {
+    let scenes = if a.scenes.is_empty() {
+        vec![PathBuf::from("scenes/cbox/cbox.xml")]
+    } else {
+        a.scenes.clone()
+    };
+    let mut rows = Vec::new();
+    let max_threads = a.threads.iter().copied().max().unwrap_or(1);
+    println!(
+        "render throughput, {}x{} at {} spp (best of {}):",
+        a.res, a.res, a.spp, a.repeat
+    );
+    println!(
+        "  {:<34} {:<26} {:>7} {:>12}",
+        "scene", "strategy", "threads", "M samples/s"
+    );
+    for path in &scenes {
+        let scene = open_scene(path, &[("res".into(), a.res.to_string())])?;
+        let name = path.display().to_string();
+        for strategy in bench_strategies() {
+            for &threads in &a.threads {
+                let sps = throughput(&scene, strategy, a.spp, threads, a.repeat);
+                println!(
+                    "  {:<34} {:<26} {:>7} {:>12.2}",
+                    name,
+                    strategy.label(),
+                    threads,
+                    sps / 1e6
+                );
+                rows.push(Row {
+                    section: "throughput",
+                    scene: name.clone(),
+                    strategy: strategy.label(),
+                    threads,
+                    n: 0,
+                    value: sps,
+                    unit: "samples/s",
+                });
+            }
+        }
+        // The ray-tracing limit for the same ray mix, on one thread, against the 1-thread
+        // render time of power MIS (which traces that mix).
+        let mix = raylimit::ray_mix(&scene, (a.spp / 16).max(1));
+        let limit = raylimit::measure(&scene, &mix, a.repeat);
+        let mis = bench_strategies()[0];
+        let render_sps = throughput(&scene, mis, a.spp, 1, a.repeat);
+        let outside = 1.0 - limit.seconds_per_sample * render_sps;
+        println!(
+            "  ray-tracing limit ({name}, 1 thread): {:.2} M closest-hit rays/s, {:.2} M occlusion rays/s; {:.2} M samples/s if tracing were all; {:.0}% of {} render time outside traversal",
+            limit.closest_per_s / 1e6,
+            limit.occlusion_per_s / 1e6,
+            1.0 / limit.seconds_per_sample / 1e6,
+            outside * 100.0,
+            mis.label()
+        );
+        for (what, v, unit) in [
+            ("closest_hit_rays", limit.closest_per_s, "rays/s"),
+            ("occlusion_rays", limit.occlusion_per_s, "rays/s"),
+            ("share_outside_traversal", outside, "fraction"),
+        ] {
+            rows.push(Row {
+                section: "ray_limit",
+                scene: name.clone(),
+                strategy: format!("{}:{what}", mis.label()),
+                threads: 1,
+                n: 0,
+                value: v,
+                unit,
+            });
+        }
+    }
+    let mis = bench_strategies()[0];
+    println!(
+        "per-sample cost as the scene grows ({} threads, power MIS):",
+        max_threads
+    );
+    for n in [1_000usize, 10_000, 100_000, 1_000_000] {
+        let scene =
+            crate::scene::Scene::build(scaling::tessellated(n)).map_err(|e| e.to_string())?;
+        let sps = throughput(&scene, mis, 16, max_threads, a.repeat);
+        let tris = scene.accel.primitive_count() as u64;
+        println!("  {:>9} triangles: {:>8.1} ns/sample", tris, 1e9 / sps);
+        rows.push(Row {
+            section: "scaling_triangles",
+            scene: "tessellated sphere".into(),
+            strategy: mis.label(),
+            threads: max_threads,
+            n: tris,
+            value: 1e9 / sps,
+            unit: "ns/sample",
+        });
+    }
+    for sel in [EmitterSelection::Uniform, EmitterSelection::Power] {
+        let s = Strategy {
+            selection: sel,
+            ..mis
+        };
+        for n in [1usize, 10, 100, 1_000, 10_000] {
+            let scene =
+                crate::scene::Scene::build(scaling::many_lights(n)).map_err(|e| e.to_string())?;
+            let sps = throughput(&scene, s, 16, max_threads, a.repeat);
+            println!(
+                "  {:>9} emitters ({}): {:>8.1} ns/sample",
+                n,
+                s.label(),
+                1e9 / sps
+            );
+            rows.push(Row {
+                section: "scaling_emitters",
+                scene: "floor under a grid of quad lights".into(),
+                strategy: s.label(),
+                threads: max_threads,
+                n: n as u64,
+                value: 1e9 / sps,
+                unit: "ns/sample",
+            });
+        }
+    }
+    if let Some(bytes) = peak_memory() {
+        println!("peak memory: {:.1} MiB", bytes as f64 / (1 << 20) as f64);
+        rows.push(Row {
+            section: "peak_memory",
+            scene: String::new(),
+            strategy: String::new(),
+            threads: 0,
+            n: 0,
+            value: bytes as f64,
+            unit: "bytes",
+        });
+    }
+    crate::film::write_atomic(&a.out, |tmp| {
+        let mut w = csv::Writer::from_path(tmp).map_err(|e| format!("{}: {e}", a.out.display()))?;
+        for r in &rows {
+            w.serialize(r).map_err(|e| e.to_string())?;
+        }
+        w.flush().map_err(|e| e.to_string())
+    })?;
+    eprintln!("wrote {}", a.out.display());
+    Ok(())
+}

@@ -1,0 +1,92 @@
+//! The ray-tracing limit: how fast the BVH alone traces the ray mix of a power-MIS render
+//! (per camera sample: one closest-hit camera ray, one shadow ray, one closest-hit BSDF ray).
+//!
+//! The mix is replayed rather than recorded, so the render loop carries no instrumentation:
+//! camera rays exactly as the renderer makes them, shadow rays to points drawn by the scene's
+//! own light sampler, and cosine-distributed rays from the camera hits (what a diffuse BSDF
+//! samples). For the bundled all-diffuse scenes that is the renderer's ray distribution.
+
+use crate::emitter::LightSampling;
+use crate::geometry::{Hit, Ray};
+use crate::math::Frame;
+use crate::rng::Rng;
+use crate::sampling::warps::square_to_cosine_hemisphere;
+use crate::scene::Scene;
+use std::time::Instant;
+
+pub struct RayMix {
+    pub camera: Vec<Ray>,
+    pub shadow: Vec<Ray>,
+    pub bsdf: Vec<Ray>,
+}
+
+/// The ray mix of `spp` samples per pixel of the scene's camera.
+pub fn ray_mix(scene: &Scene, spp: u32) -> RayMix {
+    let cam = &scene.camera;
+    let mut mix = RayMix {
+        camera: Vec::new(),
+        shadow: Vec::new(),
+        bsdf: Vec::new(),
+    };
+    for y in 0..cam.height {
+        for x in 0..cam.width {
+            for s in 0..spp {
+                let mut rng = Rng::for_sample(7, (y * cam.width + x) as u64, s as u64);
+                let ray = cam.generate_ray(x, y, &mut rng);
+                mix.camera.push(ray);
+                let Some(hit) = scene.intersect(&ray) else {
+                    continue;
+                };
+                let sp = hit.sp;
+                let e = ((rng.next_f32() * scene.emitters.len() as f32) as usize)
+                    .min(scene.emitters.len() - 1);
+                let (u_prim, u) = (rng.next_f32(), rng.next_2d());
+                if let Some(ls) =
+                    scene.emitters[e].sample(&scene.shapes, sp.p, u_prim, u, LightSampling::Area)
+                {
+                    mix.shadow.push(Scene::shadow_ray(&sp, &ls));
+                }
+                let d =
+                    Frame::from_normal(sp.ns).to_world(square_to_cosine_hemisphere(rng.next_2d()));
+                mix.bsdf.push(Ray::new(sp.spawn_origin(d), d));
+            }
+        }
+    }
+    mix
+}
+
+pub struct RayLimit {
+    /// Rays per second of closest-hit and occlusion queries, and of the whole mix.
+    pub closest_per_s: f64,
+    pub occlusion_per_s: f64,
+    /// Seconds the BVH needs for the mix of one camera sample.
+    pub seconds_per_sample: f64,
+}
+
+/// Times the mix on one thread, best of `repeat`.
+pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
+    let mut best = (f64::INFINITY, f64::INFINITY);
+    let mut sink = 0usize;
+    for _ in 0..repeat.max(1) {
+        let t = Instant::now();
+        for r in mix.camera.iter().chain(&mix.bsdf) {
+            sink += scene
+                .intersect(r)
+                .map_or(0, |h: Hit| h.sp.prim as usize & 1);
+        }
+        let closest = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        for r in &mix.shadow {
+            sink += scene.accel.occluded(r) as usize;
+        }
+        let occl = t.elapsed().as_secs_f64();
+        best = (best.0.min(closest), best.1.min(occl));
+    }
+    std::hint::black_box(sink);
+    let n_closest = (mix.camera.len() + mix.bsdf.len()) as f64;
+    RayLimit {
+        closest_per_s: n_closest / best.0,
+        occlusion_per_s: mix.shadow.len() as f64 / best.1,
+        seconds_per_sample: (best.0 + best.1) / mix.camera.len() as f64,
+    }
+}

@@ -1,0 +1,268 @@
+//! `directlab chi2`: runs the selected cases, prints a table, writes `results.csv` and one
+//! heat map (observed | expected | residual) per case, and fails if any case fails.
+//!
+//! Significance: alpha = 0.01 for the whole run, Sidak-corrected over the cases run, so a
+//! correct renderer fails a full run with probability 1 %.
+
+use super::{select, CaseConfig, Outcome};
+use crate::film::write_atomic;
+use crate::stats::{heatmap, sidak};
+use clap::Args;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Family-wise significance level of one run.
+pub const ALPHA: f64 = 0.01;
+
+#[derive(Args, Debug, Clone)]
+pub struct Chi2Args {
+    /// Run only cases whose name contains this (e.g. `emitter/`, `grazing`).
+    pub filter: Option<String>,
+    /// Samples per case.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub samples: u64,
+    /// Cells along a domain's v axis (the sphere gets 2R-1 rows of cos(theta), R of phi).
+    #[arg(long, default_value_t = 51)]
+    pub resolution: usize,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Output directory for results.csv and the heat maps.
+    #[arg(long, default_value = "reports/chi2")]
+    pub out: PathBuf,
+    /// List the cases (name and description) and exit.
+    #[arg(long)]
+    pub list: bool,
+}
+
+/// One finished case and how long it took.
+pub struct Timed {
+    pub outcome: Outcome,
+    pub seconds: f64,
+}
+
+fn verdict(o: &Outcome) -> &'static str {
+    if o.passed() {
+        "pass"
+    } else {
+        "FAIL"
+    }
+}
+
+/// The heat map's path: the case name's groups become directories.
+pub fn png_path(out: &Path, name: &str) -> PathBuf {
+    out.join(format!("{name}.png"))
+}
+
+fn write_png(out: &Path, o: &Outcome) -> Result<(), String> {
+    let path = png_path(out, &o.name);
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    let (c, r) = (o.chi2.observed.cols, o.chi2.observed.rows);
+    let cell_px = (360 / c.max(r).max(1)).clamp(2, 24) as u32;
+    heatmap::write(&path, &o.chi2, cell_px).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// `results.csv`, one row per case.
+pub fn write_csv(path: &Path, rows: &[Timed], cfg: &CaseConfig) -> Result<(), String> {
+    write_atomic(path, |tmp| {
+        let mut w = csv::Writer::from_path(tmp).map_err(|e| e.to_string())?;
+        let err = |e: csv::Error| e.to_string();
+        w.write_record([
+            "case",
+            "domain",
+            "samples",
+            "resolution",
+            "seed",
+            "statistic",
+            "dof",
+            "p_value",
+            "threshold",
+            "verdict",
+            "lost",
+            "pdf_integral",
+            "checks",
+            "reason",
+            "seconds",
+        ])
+        .map_err(err)?;
+        for t in rows {
+            let o = &t.outcome;
+            let c = &o.chi2;
+            let checks: Vec<String> = o
+                .checks
+                .iter()
+                .map(|k| format!("{}={}", k.name, if k.passed { "pass" } else { "fail" }))
+                .collect();
+            w.write_record([
+                o.name.clone(),
+                c.domain.to_string(),
+                c.samples.to_string(),
+                cfg.resolution.to_string(),
+                cfg.seed.to_string(),
+                format!("{:.6}", c.statistic),
+                c.dof.to_string(),
+                format!("{:.6e}", c.p_value),
+                format!("{:.6e}", c.threshold),
+                verdict(o).to_string(),
+                c.lost.to_string(),
+                format!("{:.8}", c.pdf_integral),
+                checks.join(";"),
+                o.summary(),
+                format!("{:.3}", t.seconds),
+            ])
+            .map_err(err)?;
+        }
+        w.flush().map_err(|e| e.to_string())
+    })
+}
+
+/// The printed table.
+pub fn table(rows: &[Timed]) -> String {
+    let width = rows
+        .iter()
+        .map(|t| t.outcome.name.len())
+        .max()
+        .unwrap_or(4)
+        .max(4);
+    let mut s = format!(
+        "{:<width$}  {:>12}  {:>6}  {:>10}  {:>10}  {:>7}\n",
+        "case", "statistic", "dof", "p-value", "threshold", "verdict"
+    );
+    for t in rows {
+        let o = &t.outcome;
+        let c = &o.chi2;
+        // No statistic: an immediate verdict (impossible samples, or nothing to compare).
+        let stat = if c.statistic.is_nan() {
+            "-".to_string()
+        } else {
+            format!("{:.2}", c.statistic)
+        };
+        s += &format!(
+            "{:<width$}  {:>12}  {:>6}  {:>10.3e}  {:>10.3e}  {:>7}\n",
+            o.name,
+            stat,
+            c.dof,
+            c.p_value,
+            c.threshold,
+            verdict(o)
+        );
+    }
+    s
+}
+
+/// Runs the command; Ok(true) when every case passed.
+pub fn run(a: &Chi2Args) -> Result<bool, String> {
+    let cases = select(a.filter.as_deref().unwrap_or(""));
+    if a.list {
+        for c in &cases {
+            println!("{:<40} {}", c.name, c.about);
+        }
+        return Ok(true);
+    }
+    if cases.is_empty() {
+        return Err(format!(
+            "no case matches '{}' (see --list)",
+            a.filter.as_deref().unwrap_or("")
+        ));
+    }
+    if a.samples < 100 {
+        return Err("--samples must be at least 100".into());
+    }
+    let cfg = CaseConfig {
+        samples: a.samples,
+        resolution: a.resolution.max(3),
+        seed: a.seed,
+        alpha: sidak(ALPHA, cases.len()),
+        ..CaseConfig::default()
+    };
+    eprintln!(
+        "{} cases, {} samples each, resolution {}, seed {}; alpha {ALPHA} Sidak-corrected to \
+         {:.3e} per case",
+        cases.len(),
+        cfg.samples,
+        cfg.resolution,
+        cfg.seed,
+        cfg.alpha
+    );
+    let start = Instant::now();
+    let rows: Vec<Timed> = cases
+        .par_iter()
+        .map(|case| {
+            let t = Instant::now();
+            let outcome = case.run(&cfg);
+            let seconds = t.elapsed().as_secs_f64();
+            eprintln!(
+                "  {:<44} {} ({seconds:.1} s)",
+                outcome.name,
+                verdict(&outcome)
+            );
+            Timed { outcome, seconds }
+        })
+        .collect();
+    print!("{}", table(&rows));
+    for t in &rows {
+        write_png(&a.out, &t.outcome)?;
+    }
+    let csv = a.out.join("results.csv");
+    write_csv(&csv, &rows, &cfg)?;
+    let failed: Vec<&Timed> = rows.iter().filter(|t| !t.outcome.passed()).collect();
+    for t in &failed {
+        println!("FAIL {}: {}", t.outcome.name, t.outcome.summary());
+    }
+    eprintln!(
+        "{} of {} cases passed in {:.1} s; wrote {} and heat maps under {}",
+        rows.len() - failed.len(),
+        rows.len(),
+        start.elapsed().as_secs_f64(),
+        csv.display(),
+        a.out.display()
+    );
+    Ok(failed.is_empty())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writes_csv_and_heat_maps_and_reports_failures() {
+        let dir = std::env::temp_dir().join(format!("directlab-chi2cmd-{}", std::process::id()));
+        let args = Chi2Args {
+            filter: Some("warp/uniform-disk".into()),
+            samples: 20_000,
+            resolution: 11,
+            seed: 3,
+            out: dir.clone(),
+            list: false,
+        };
+        // 20k samples on 11 x 11 cells at alpha 0.01: a correct warp passes.
+        assert_eq!(run(&args), Ok(true));
+        let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 2, "{csv}");
+        assert!(lines[0].starts_with("case,domain,samples,resolution,seed,statistic,dof,p_value"));
+        assert!(lines[1].starts_with("warp/uniform-disk,unit disk,20000,11,3,"));
+        assert!(png_path(&dir, "warp/uniform-disk").exists());
+        let none = Chi2Args {
+            filter: Some("no-such-case".into()),
+            ..args
+        };
+        assert!(run(&none).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+
+        // A failing outcome is marked in the table.
+        let mut o = select("warp/uniform-disk")[0].run(&CaseConfig {
+            samples: 1000,
+            resolution: 5,
+            ..CaseConfig::default()
+        });
+        o.chi2.verdict = crate::stats::Verdict::Fail;
+        let t = table(&[Timed {
+            outcome: o,
+            seconds: 0.0,
+        }]);
+        assert!(t.lines().nth(1).unwrap().ends_with("FAIL"), "{t}");
+    }
+}

@@ -1,0 +1,198 @@
+//! Statistics of one probe's samples against its reference: bias (z), error, fireflies and
+//! the convergence slope.
+
+/// Everything the report says about one (case, strategy).
+#[derive(Clone, Debug, Default)]
+pub struct Measured {
+    pub n: u64,
+    pub non_finite: u64,
+    pub mean: f64,
+    /// Sample variance (of one sample, not of the mean).
+    pub variance: f64,
+    /// (mean - reference) / standard error (see `z_score`).
+    pub z: f64,
+    /// relMSE at `RELMSE_SPP` samples per pixel, measured over independent batches.
+    pub rel_mse: f64,
+    pub max_sample: f64,
+    /// Share of the total squared error (x - reference)^2 carried by the largest 0.1 %.
+    pub top_share: f64,
+    /// Least-squares slope of log MSE against log spp (-1 for a well-behaved estimator).
+    pub slope: f64,
+    /// (spp, relMSE) over powers of two, each from at least `MIN_BATCHES` batches.
+    pub curve: Vec<(u32, f64)>,
+}
+
+/// Family-wise significance of the report's and the tests' z-tests, as the render tests.
+pub const ALPHA: f64 = 1e-3;
+
+/// Two-sided critical |z| at level `alpha`, Šidák-corrected for `m` tests.
+pub fn z_critical(alpha: f64, m: usize) -> f64 {
+    use statrs::distribution::{ContinuousCDF, Normal};
+    let a = 1.0 - (1.0 - alpha).powf(1.0 / m.max(1) as f64);
+    Normal::new(0.0, 1.0)
+        .expect("standard normal")
+        .inverse_cdf(1.0 - a / 2.0)
+}
+
+/// Samples per pixel at which the table's relMSE is reported.
+pub const RELMSE_SPP: u32 = 1024;
+/// Fewest independent batches an MSE point is averaged over.
+pub const MIN_BATCHES: usize = 32;
+
+/// Relative error normalisation: the reference squared, or 1 (absolute MSE) when it is 0.
+fn norm(reference: f64) -> f64 {
+    if reference != 0.0 {
+        reference * reference
+    } else {
+        1.0
+    }
+}
+
+/// Relative accuracy an f32 estimator can be held to: its per-sample arithmetic is rounded at
+/// ~6e-8 a step, and a systematic error of a few such steps survives any sample count. Added
+/// to the standard error so that near-constant estimators are not failed for f32 rounding.
+pub const F32_FLOOR: f64 = 1e-6;
+
+/// Confidence bound on an outcome never seen in n draws: p < -ln(alpha) / n at level alpha
+/// (the rule of three at alpha = 0.05), here at the report's alpha = 1e-3.
+fn unseen_probability(n: u64) -> f64 {
+    -(ALPHA.ln()) / n as f64
+}
+
+/// z of the mean against the reference, with the f32 floor in the standard error.
+///
+/// Zero sample variance (all n samples equal) says nothing about outcomes rarer than ~1/n.
+/// For a non-negative estimator, a missed rare outcome below the constant value v shifts the
+/// mean by at most p v, so a constant v above the reference is consistent when
+/// v - reference <= v p_unseen(n); a constant below the reference is not (the missing
+/// outcomes would have to be larger, by an unknown amount) and gets an infinite z.
+pub fn z_score(mean: f64, variance: f64, n: u64, reference: f64) -> f64 {
+    let floor = F32_FLOOR * reference.abs();
+    if variance == 0.0 {
+        let d = mean - reference;
+        return if d.abs() <= floor || (d > 0.0 && d <= mean * unseen_probability(n)) {
+            0.0
+        } else {
+            d.signum() * f64::INFINITY
+        };
+    }
+    (mean - reference) / (variance / n as f64 + floor * floor).sqrt()
+}
+
+/// MSE of batch means of `spp` consecutive samples (batches are independent: every sample
+/// has its own random stream).
+fn batch_mse(x: &[f64], spp: usize, reference: f64) -> f64 {
+    let batches = x.len() / spp;
+    let s: f64 = x
+        .chunks_exact(spp)
+        .map(|b| (b.iter().sum::<f64>() / spp as f64 - reference).powi(2))
+        .sum();
+    s / batches as f64
+}
+
+/// Slope of the least-squares line through (log x, log y); NaN with fewer than two usable
+/// points (zero error has no logarithm).
+pub fn log_slope(points: &[(u32, f64)]) -> f64 {
+    let p: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(_, y)| *y > 0.0 && y.is_finite())
+        .map(|&(x, y)| ((x as f64).ln(), y.ln()))
+        .collect();
+    if p.len() < 2 {
+        return f64::NAN;
+    }
+    let n = p.len() as f64;
+    let (mx, my) = (
+        p.iter().map(|a| a.0).sum::<f64>() / n,
+        p.iter().map(|a| a.1).sum::<f64>() / n,
+    );
+    let sxy: f64 = p.iter().map(|a| (a.0 - mx) * (a.1 - my)).sum();
+    let sxx: f64 = p.iter().map(|a| (a.0 - mx).powi(2)).sum();
+    sxy / sxx
+}
+
+/// Share of sum (x - r)^2 carried by the largest ceil(0.1 %) of the terms; NaN if all are 0.
+pub fn top_share(x: &[f64], reference: f64) -> f64 {
+    let mut e: Vec<f64> = x.iter().map(|v| (v - reference).powi(2)).collect();
+    let total: f64 = e.iter().sum();
+    if !(total > 0.0) {
+        return f64::NAN;
+    }
+    let k = x.len().div_ceil(1000).max(1);
+    let i = e.len() - k;
+    e.select_nth_unstable_by(i, f64::total_cmp);
+    e[i..].iter().sum::<f64>() / total
+}
+
+pub fn measure(x: &[f64], non_finite: u64, reference: f64) -> Measured {
+    let n = x.len();
+    let mean = x.iter().sum::<f64>() / n as f64;
+    let variance = if n > 1 {
+        x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64
+    } else {
+        0.0
+    };
+    let mut curve = Vec::new();
+    let mut spp = 1;
+    while n / spp >= MIN_BATCHES {
+        curve.push((spp as u32, batch_mse(x, spp, reference) / norm(reference)));
+        spp *= 2;
+    }
+    let rel_mse = if n / RELMSE_SPP as usize >= MIN_BATCHES {
+        batch_mse(x, RELMSE_SPP as usize, reference) / norm(reference)
+    } else {
+        f64::NAN
+    };
+    Measured {
+        n: n as u64,
+        non_finite,
+        mean,
+        variance,
+        z: z_score(mean, variance, n as u64, reference),
+        rel_mse,
+        max_sample: x.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        top_share: top_share(x, reference),
+        slope: log_slope(&curve),
+        curve,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+
+    #[test]
+    fn extreme_measure_of_uniform_samples() {
+        let mut rng = Rng::new(3, 1);
+        let x: Vec<f64> = (0..1 << 16).map(|_| rng.next_f64()).collect();
+        let m = measure(&x, 0, 0.5);
+        assert!(m.z.abs() < 4.0, "{m:?}");
+        assert!((m.variance - 1.0 / 12.0).abs() < 2e-3);
+        // relMSE at 1024 spp: (1/12) / 1024 / 0.25.
+        assert!((m.rel_mse / (1.0 / 12.0 / 1024.0 / 0.25) - 1.0).abs() < 0.5);
+        assert!((m.slope + 1.0).abs() < 0.1, "slope {}", m.slope);
+        // The top 0.1 % of squared errors of U(0,1) around 0.5 carry about 0.3 % of the sum.
+        assert!(
+            m.top_share > 0.002 && m.top_share < 0.005,
+            "{}",
+            m.top_share
+        );
+    }
+
+    #[test]
+    fn extreme_firefly_share_and_zero_variance() {
+        let mut x = vec![1.0; 10_000];
+        x[17] = 1e6;
+        assert!(top_share(&x, 1.0) > 0.999);
+        assert_eq!(z_score(2.0, 0.0, 10, 2.0), 0.0);
+        assert!(z_score(2.0 * (1.0 + 1e-7), 1e-30, 10, 2.0).abs() < 1.0);
+        assert_eq!(z_score(2.0 * (1.0 - 5e-7), 0.0, 10, 2.0), 0.0);
+        assert!(z_score(2.1, 0.0, 10_000, 2.0).is_infinite());
+        // Constant above the reference: a rare zero (p < 6.9 / n) may not have been drawn.
+        assert_eq!(z_score(2.001, 0.0, 1000, 2.0), 0.0);
+        assert!(z_score(2.1, 0.0, 1000, 2.0).is_infinite());
+        assert!(z_score(1.999, 0.0, 1000, 2.0) == f64::NEG_INFINITY);
+        assert!(top_share(&[0.0; 10], 0.0).is_nan());
+    }
+}
