@@ -56,7 +56,7 @@ fn settings(md: &mut String, o: &Outcome) {
     let _ = writeln!(
         md,
         "- Reference: `{}` at {} spp, seed {}, {:.1} s to render ({}), {} non-finite samples; \
-         cache key `{}`.",
+         cache key `{}`, renderer source hash `{}`.",
         ri.strategy,
         ri.spp,
         ri.seed,
@@ -67,7 +67,8 @@ fn settings(md: &mut String, o: &Outcome) {
             "rendered in this run"
         },
         ri.non_finite_samples,
-        ri.key
+        ri.key,
+        ri.renderer
     );
     let near = o.rows.iter().filter(|r| r.near_floor).count();
     let _ = writeln!(
@@ -141,33 +142,63 @@ pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> R
     })
 }
 
-/// Writes `<root>/index.md` linking every experiment folder that has a report.
+/// Writes `<root>/index.md` linking every report under `root`: each folder's `index.md`
+/// (experiments, and other commands' reports) and loose Markdown files.
 pub fn write_root_index(root: &Path) -> Result<(), String> {
     let mut entries: Vec<(String, String)> = Vec::new();
     if let Ok(rd) = std::fs::read_dir(root) {
         for d in rd.flatten() {
-            let idx = d.path().join("index.md");
-            let Ok(text) = std::fs::read_to_string(&idx) else {
+            let name = d.file_name().to_string_lossy().to_string();
+            let link = if d.path().is_dir() {
+                format!("{name}/index.md")
+            } else if name.ends_with(".md") && name != "index.md" {
+                name.clone()
+            } else {
                 continue;
             };
-            let name = d.file_name().to_string_lossy().to_string();
+            let Ok(text) = std::fs::read_to_string(root.join(&link)) else {
+                continue;
+            };
             let title = text
                 .lines()
                 .next()
                 .and_then(|l| l.strip_prefix("# "))
                 .unwrap_or(&name)
                 .to_string();
-            entries.push((name, title));
+            entries.push((link, title));
         }
     }
     entries.sort();
-    let mut md =
-        String::from("# Experiments\n\nWritten by `directlab run` / `directlab reproduce`.\n\n");
-    for (name, title) in &entries {
-        let _ = writeln!(md, "- [{title}]({name}/index.md)");
+    let mut md = String::from("# Reports\n\nWritten by `directlab run` / `directlab reproduce`; links every report found here.\n\n");
+    for (link, title) in &entries {
+        let _ = writeln!(md, "- [{title}]({link})");
     }
     let path = root.join("index.md");
     write_atomic(&path, |tmp| {
         std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display()))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn root_index_links_report_folders_and_loose_markdown() {
+        let dir = std::env::temp_dir().join(format!("directlab-root-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("fig1")).unwrap();
+        std::fs::create_dir_all(dir.join("empty")).unwrap();
+        std::fs::write(dir.join("fig1/index.md"), "# Figure 1\n").unwrap();
+        std::fs::write(dir.join("gallery.md"), "# Bug gallery\n").unwrap();
+        write_root_index(&dir).unwrap();
+        let md = std::fs::read_to_string(dir.join("index.md")).unwrap();
+        assert!(md.contains("- [Figure 1](fig1/index.md)"), "{md}");
+        assert!(md.contains("- [Bug gallery](gallery.md)"), "{md}");
+        assert!(!md.contains("empty"), "{md}");
+        write_root_index(&dir).unwrap();
+        let again = std::fs::read_to_string(dir.join("index.md")).unwrap();
+        assert_eq!(md, again, "the index does not list itself");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
