@@ -90,7 +90,7 @@ pub(super) fn diagnostics(md: &mut String, o: &Outcome, series: &[Series]) {
         };
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {:.2} | {:.3} | {reading} |",
+            "| {} | {} | {} | {} | {} | {:.2} | {:.3e} | {reading} |",
             s.name,
             s.slope.map_or("-".into(), |k| format!("{k:.2}")),
             sm.slope.map_or("-".into(), |k| format!("{k:.2}")),
