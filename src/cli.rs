@@ -51,7 +51,8 @@ pub struct SweepArgs {
     /// Worker threads (default: all cores). Images do not depend on it; timings do.
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Render the references again even if the cache has them (after changing the renderer).
+    /// Render the references again even if the cache has them (after upgrading a
+    /// dependency; changes to the renderer's own source are detected).
     #[arg(long)]
     pub fresh_reference: bool,
 }

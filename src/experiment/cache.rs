@@ -1,9 +1,10 @@
 //! Reference images: rendered once at high spp and cached under a key that changes whenever
 //! anything that could change the image changes: the scene file and every file it references
-//! (meshes), the `-D` overrides, the reference's spp, seed and estimator, and the crate version.
+//! (meshes), the `-D` overrides, the reference's spp, seed and estimator, the crate version and
+//! a hash of the renderer's source (`build.rs`).
 //!
-//! The key does not see edits to the renderer that keep the crate version; `--fresh-reference`
-//! re-renders after such a change.
+//! The key does not see dependency upgrades (a new glam or obvhs could round differently);
+//! `--fresh-reference` re-renders after such a change.
 
 use crate::film::{self, Image};
 use crate::integrator::Strategy;
@@ -11,6 +12,9 @@ use crate::render::{render, RenderSettings};
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+
+/// Hash of the renderer's source files, computed by `build.rs`.
+pub const RENDERER_HASH: &str = env!("DIRECTLAB_RENDERER_HASH");
 
 /// FNV-1a, 64 bit: stable across Rust versions and platforms, unlike `DefaultHasher`.
 pub struct Fnv(u64);
@@ -77,6 +81,7 @@ pub struct KeyInputs<'a> {
 pub fn reference_key(k: &KeyInputs) -> Result<String, String> {
     let mut h = Fnv::new();
     h.field(env!("CARGO_PKG_VERSION").as_bytes());
+    h.field(RENDERER_HASH.as_bytes());
     for f in scene_files(k.scene, k.defines)? {
         let bytes = std::fs::read(&f).map_err(|e| format!("{}: cannot read: {e}", f.display()))?;
         // File names relative to the scene folder would be nicer, but the contents are what
@@ -97,6 +102,9 @@ pub fn reference_key(k: &KeyInputs) -> Result<String, String> {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ReferenceInfo {
     pub key: String,
+    /// `RENDERER_HASH` of the binary that rendered it.
+    #[serde(default)]
+    pub renderer: String,
     pub strategy: String,
     pub spp: u32,
     pub seed: u64,
@@ -193,6 +201,7 @@ pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, St
     let (mse_floor, relmse_floor) = noise_floor(&out.mean, &out.variance, req.relmse_epsilon);
     let info = ReferenceInfo {
         key: req.key.clone(),
+        renderer: RENDERER_HASH.to_string(),
         strategy: req.strategy.label(),
         spp: req.spp,
         seed: req.seed,
@@ -210,12 +219,27 @@ pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, St
     film::write_atomic(&j, |tmp| {
         std::fs::write(tmp, json).map_err(|e| format!("{}: {e}", j.display()))
     })?;
+    prune(dir, &req.key);
     Ok(Reference {
         mean: out.mean,
         variance: out.variance,
         info,
         cached: false,
     })
+}
+
+/// Removes references of other keys (an older scene, renderer or setting): one experiment
+/// folder keeps one reference, instead of a growing pile of 5 MB EXRs.
+fn prune(dir: &Path, key: &str) {
+    let Ok(rd) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in rd.flatten() {
+        let name = e.file_name().to_string_lossy().to_string();
+        if name.starts_with("reference-") && !name.starts_with(&format!("reference-{key}")) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
 }
 
 #[cfg(test)]
@@ -280,6 +304,29 @@ mod tests {
             "the edit must apply"
         );
         assert_ne!(base, k(&defines, 64, &s));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_new_reference_replaces_older_keys_only() {
+        let dir = std::env::temp_dir().join(format!("directlab-prune-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("images")).unwrap();
+        for f in [
+            "reference-old.exr",
+            "reference-old.json",
+            "reference-new.exr",
+            "other.txt",
+        ] {
+            std::fs::write(dir.join(f), "").unwrap();
+        }
+        prune(&dir, "new");
+        let mut left: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+            .collect();
+        left.sort();
+        assert_eq!(left, ["images", "other.txt", "reference-new.exr"]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -5,6 +5,8 @@ pub mod analysis;
 pub mod cache;
 pub mod figures;
 pub mod leftout;
+mod measure;
+pub mod plan;
 pub mod results;
 pub mod runner;
 pub mod schema;

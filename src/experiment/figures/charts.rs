@@ -1,0 +1,94 @@
+//! Convergence charts: error against spp and against time, and efficiency.
+
+use super::Figure;
+use crate::experiment::analysis::{metric_name, series, Point, Series};
+use crate::experiment::runner::Outcome;
+use crate::experiment::schema::ErrorMetric;
+use crate::plot::{write_chart, Line, LogLogChart};
+
+pub fn charts(o: &Outcome) -> Result<(Vec<Series>, Vec<Figure>), String> {
+    let m = o.exp.exp.metrics.primary;
+    let eps = o.exp.exp.metrics.relmse_epsilon;
+    let what = metric_name(m, eps);
+    let ss = series(&o.rows, &o.strategies, m);
+    let floor = match m {
+        ErrorMetric::Mse => o.reference.info.mse_floor,
+        ErrorMetric::Relmse => o.reference.info.relmse_floor,
+    };
+    let line = |s: &Series, f: &dyn Fn(&Point) -> (f64, f64)| Line {
+        label: match s.slope {
+            Some(k) => format!("{} (slope {k:.2})", s.name),
+            None => s.name.clone(),
+        },
+        points: s.points.iter().map(f).collect(),
+        spread: s.points.iter().map(|p| (p.min, p.max)).collect(),
+    };
+    let mut figs = Vec::new();
+    let mut chart = |file: &str, c: LogLogChart, caption: String| -> Result<(), String> {
+        write_chart(&o.dir.join(file), &c)?;
+        figs.push(Figure {
+            file: format!("{file}.png"),
+            caption: format!("{caption} ([SVG]({file}.svg))"),
+        });
+        Ok(())
+    };
+    chart(
+        "convergence",
+        LogLogChart {
+            title: format!("{what} vs samples per pixel"),
+            x_label: "samples per pixel".into(),
+            y_label: what.clone(),
+            lines: ss
+                .iter()
+                .map(|s| line(s, &|p| (p.spp as f64, p.error)))
+                .collect(),
+            hline: Some((floor, "reference noise floor".into())),
+        },
+        format!(
+            "{what} (corrected for the reference noise) against spp, mean over {} seeds; bars span \
+             the seeds' minimum to maximum; slopes are least-squares fits in log-log, from points \
+             clear of the noise floor (a 1/N estimator has slope -1).",
+            o.exp.exp.seeds
+        ),
+    )?;
+    chart(
+        "error_vs_time",
+        LogLogChart {
+            title: format!("{what} vs render time"),
+            x_label: "render seconds".into(),
+            y_label: what.clone(),
+            lines: ss
+                .iter()
+                .map(|s| line(s, &|p| (p.seconds, p.error)))
+                .collect(),
+            hline: Some((floor, "reference noise floor".into())),
+        },
+        "Error against render time (the same runs): lower-left is better.".into(),
+    )?;
+    let eff: Vec<Line> = ss
+        .iter()
+        .map(|s| Line {
+            label: s.name.clone(),
+            points: s
+                .points
+                .iter()
+                .map(|p| (p.spp as f64, p.efficiency()))
+                .collect(),
+            spread: vec![],
+        })
+        .collect();
+    chart(
+        "efficiency",
+        LogLogChart {
+            title: "efficiency 1 / (error x time)".into(),
+            x_label: "samples per pixel".into(),
+            y_label: format!("1 / ({what} x seconds)"),
+            lines: eff,
+            hline: None,
+        },
+        "Efficiency 1/(error x time) against spp: higher is better; flat for a 1/N estimator \
+         whose cost grows linearly with spp."
+            .into(),
+    )?;
+    Ok((ss, figs))
+}
