@@ -1,9 +1,11 @@
-//! One compressed wide BVH (obvhs CwBvh) over every triangle and sphere of the scene.
+//! The scene's acceleration structure: one 4-wide BVH (see `bvh4`) over every triangle and
+//! sphere, with primitive data stored in leaf order.
 
+use super::bvh4::{Bvh4, MAX_LEAF};
 use super::shape::{intersect_sphere, Shape, ShapeKind, WatertightRay};
 use super::{Hit, Ray};
 use glam::{Vec2, Vec3, Vec3A};
-use obvhs::{aabb::Aabb, cwbvh::CwBvh, ray::RayHit, BvhBuildParams};
+use obvhs::{aabb::Aabb, bvh2::builder::build_bvh2, BvhBuildParams};
 use std::time::Duration;
 
 /// Primitive data stored in BVH leaf order, so the traversal callback indexes it directly.
@@ -13,13 +15,8 @@ enum Prim {
     Sphere { c: Vec3, r: f32 },
 }
 
-/// The BVH works in a copy of the scene scaled by a power of two (`scale`) so that the scene
-/// spans about 2^20 units. obvhs culls boxes entered closer than an absolute t of 1e-4
-/// (`cwbvh::node::EPSILON`); in the scaled space that is ~1e-10 of the scene at any scene
-/// scale. Power-of-two scaling is exact, so every hit is the same as in the original space.
 pub struct Accel {
-    bvh: Option<CwBvh>,
-    scale: f32,
+    bvh: Bvh4,
     prims: Vec<Prim>,
     /// (shape index, triangle index within the shape) per primitive, in leaf order.
     refs: Vec<(u32, u32)>,
@@ -28,18 +25,6 @@ pub struct Accel {
 impl Accel {
     /// Builds over all shapes; zero-area triangles are left out since no ray can hit them.
     pub fn build(shapes: &[Shape]) -> Accel {
-        let magnitude = shapes
-            .iter()
-            .map(|s| match &s.kind {
-                ShapeKind::Mesh(m) => m.bounds_scale(),
-                ShapeKind::Sphere(s) => crate::math::max_abs(s.center) + s.radius,
-            })
-            .fold(0.0f32, f32::max);
-        let scale = if magnitude > 0.0 && magnitude.is_finite() {
-            2f32.powi((20 - magnitude.log2().ceil() as i32).clamp(-100, 100))
-        } else {
-            1.0
-        };
         let mut prims = Vec::new();
         let mut refs = Vec::new();
         let mut aabbs = Vec::new();
@@ -51,14 +36,14 @@ impl Accel {
                         if (b - a).cross(c - a).length_squared() == 0.0 {
                             continue;
                         }
-                        let v = [a, b, c].map(|p| Vec3A::from(p * scale));
+                        let v = [a, b, c].map(Vec3A::from);
                         prims.push(Prim::Tri { v });
                         refs.push((si as u32, ti as u32));
                         aabbs.push(Aabb::from_points(&v));
                     }
                 }
                 ShapeKind::Sphere(s) => {
-                    let (c, r) = (s.center * scale, s.radius * scale);
+                    let (c, r) = (s.center, s.radius);
                     prims.push(Prim::Sphere { c, r });
                     refs.push((si as u32, 0));
                     let r = Vec3A::splat(r);
@@ -69,30 +54,21 @@ impl Accel {
         }
         if prims.is_empty() {
             return Accel {
-                bvh: None,
-                scale,
+                bvh: Bvh4::empty(),
                 prims,
                 refs,
             };
         }
-        let mut t = Duration::ZERO;
-        let bvh =
-            obvhs::cwbvh::builder::build_cwbvh(&aabbs, BvhBuildParams::medium_build(), &mut t);
-        let prims = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| prims[i as usize])
-            .collect();
-        let refs = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| refs[i as usize])
-            .collect();
+        let params = BvhBuildParams {
+            max_prims_per_leaf: 4.min(MAX_LEAF),
+            ..BvhBuildParams::medium_build()
+        };
+        let bvh2 = build_bvh2(&aabbs, params, &mut Duration::default());
+        let order = &bvh2.primitive_indices;
         Accel {
-            bvh: Some(bvh),
-            scale,
-            prims,
-            refs,
+            bvh: Bvh4::from_bvh2(&bvh2),
+            prims: order.iter().map(|&i| prims[i as usize]).collect(),
+            refs: order.iter().map(|&i| refs[i as usize]).collect(),
         }
     }
 
@@ -129,43 +105,44 @@ impl Accel {
 
     /// Closest hit within the ray's interval.
     pub fn intersect(&self, ray: &Ray, shapes: &[Shape]) -> Option<Hit> {
-        let bvh = self.bvh.as_ref()?;
-        let k = self.scale;
-        let (o, d, tmin) = (ray.o * k, ray.d, ray.tmin * k);
-        let r = obvhs::ray::Ray::new(o.into(), d.into(), tmin, ray.tmax * k);
-        let mut hit = RayHit::none();
+        let (o, d, tmin) = (ray.o, ray.d, ray.tmin);
         let wr = WatertightRay::new(o, d);
-        // obvhs keeps the closest t; the barycentrics of the current best ride along.
+        // The barycentrics of the current best ride along.
         let mut best_bary = Vec2::ZERO;
-        let found = bvh.ray_traverse(r, &mut hit, |r, i| {
-            let (t, bary) = self.prim_hit(i, &wr, o, d, tmin, r.tmax);
-            if t < r.tmax {
-                best_bary = bary;
-            }
-            t
-        });
-        if !found {
-            return None;
-        }
-        let i = hit.primitive_id as usize;
+        let (i, t) = self.bvh.closest(
+            o,
+            d,
+            tmin,
+            ray.tmax,
+            #[inline(always)]
+            |i, tmax| {
+                let (t, bary) = self.prim_hit(i, &wr, o, d, tmin, tmax);
+                if t < tmax {
+                    best_bary = bary;
+                }
+                t
+            },
+        )?;
         let (shape, local) = self.refs[i];
         let sp = match &shapes[shape as usize].kind {
             ShapeKind::Mesh(m) => m.surface_point(local as usize, best_bary, shape),
-            ShapeKind::Sphere(s) => s.surface_point(ray.o + ray.d * (hit.t / k), shape),
+            ShapeKind::Sphere(s) => s.surface_point(ray.o + ray.d * t, shape),
         };
-        Some(Hit { t: hit.t / k, sp })
+        Some(Hit { t, sp })
     }
 
     /// True if anything blocks the ray within its interval.
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let Some(bvh) = self.bvh.as_ref() else {
-            return false;
-        };
-        let k = self.scale;
-        let (o, d, tmin, tmax) = (ray.o * k, ray.d, ray.tmin * k, ray.tmax * k);
-        let r = obvhs::ray::Ray::new(o.into(), d.into(), tmin, tmax);
+        let (o, d, tmin, tmax) = (ray.o, ray.d, ray.tmin, ray.tmax);
         let wr = WatertightRay::new(o, d);
-        !bvh.ray_traverse_miss(r, |_, i| self.prim_t(i, &wr, o, d, tmin, tmax))
+        self.bvh.any(
+            o,
+            d,
+            tmin,
+            tmax,
+            #[inline(always)]
+            |i, tmax| self.prim_t(i, &wr, o, d, tmin, tmax),
+        )
     }
 }
 
@@ -221,12 +198,10 @@ mod tests {
             let o = Vec3::new(rng.next_f32() * 1.4 - 0.2, rng.next_f32() * 1.4 - 0.2, 2.0);
             let d = Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, -1.0).normalize();
             let ray = Ray::new(o, d);
-            let ko = o * accel.scale;
-            let wr = WatertightRay::new(ko, d);
+            let wr = WatertightRay::new(o, d);
             let brute = (0..accel.prims.len())
-                .map(|i| accel.prim_t(i, &wr, ko, d, 0.0, f32::INFINITY))
-                .fold(f32::INFINITY, f32::min)
-                / accel.scale;
+                .map(|i| accel.prim_t(i, &wr, o, d, 0.0, f32::INFINITY))
+                .fold(f32::INFINITY, f32::min);
             match accel.intersect(&ray, &shapes) {
                 Some(h) => {
                     hits += 1;

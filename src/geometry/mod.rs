@@ -1,6 +1,7 @@
 //! Geometry: shapes in world space, their intersection, and the BVH over all of them.
 
 pub mod accel;
+mod bvh4;
 mod refine;
 pub mod shape;
 
