@@ -8,7 +8,7 @@
 //! is missing from p(ω), which the chi-square test counts as "lost".
 
 use crate::emitter::{Emitter, EmitterSelection, EmitterSelector, LightSampling};
-use crate::geometry::shape::intersect_triangle;
+use crate::geometry::watertight::intersect_triangle;
 use crate::geometry::{ShapeKind, SurfacePoint};
 use crate::rng::Rng;
 use crate::scene::Scene;

@@ -8,7 +8,7 @@ use super::lobe::{normal_window, run_windowed};
 use super::tangent::Tangent;
 use super::{Case, CaseConfig};
 use crate::analytic::triangle_solid_angle;
-use crate::geometry::shape::intersect_triangle;
+use crate::geometry::watertight::intersect_triangle;
 use crate::rng::Rng;
 use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
 use crate::sampling::spherical::sample_spherical_triangle;

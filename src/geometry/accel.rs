@@ -1,25 +1,41 @@
-//! The scene's acceleration structure: one 4-wide BVH (see `bvh4`) over every triangle and
-//! sphere, with primitive data stored in leaf order.
+//! The scene's acceleration structure: one 4-wide BVH (see `bvh4`) whose leaves hold up to
+//! four triangles as one SIMD packet (see `watertight`), plus any spheres.
 
-use super::bvh4::{Bvh4, MAX_LEAF};
-use super::shape::{intersect_sphere, Shape, ShapeKind, WatertightRay};
+use super::bvh4::Bvh4;
+use super::shape::{intersect_sphere, Shape, ShapeKind};
+use super::watertight::{Tri4, WatertightRay};
 use super::{Hit, Ray};
 use glam::{Vec2, Vec3, Vec3A};
 use obvhs::{aabb::Aabb, bvh2::builder::build_bvh2, BvhBuildParams};
 use std::time::Duration;
 
-/// Primitive data stored in BVH leaf order, so the traversal callback indexes it directly.
+/// Triangles per packet, and so the most primitives a BVH leaf may hold.
+const LEAF_SIZE: usize = 4;
+
+/// One BVH leaf: its triangles as a packet and its spheres.
 #[derive(Clone, Copy, Debug)]
-enum Prim {
-    Tri { v: [Vec3A; 3] },
-    Sphere { c: Vec3, r: f32 },
+struct Leaf {
+    tris: Tri4,
+    /// Per lane, the triangle's index in `refs` (unused lanes repeat lane 0).
+    tri_ref: [u32; 4],
+    n_tris: u32,
+    /// Range in `spheres`.
+    spheres: (u32, u32),
 }
 
 pub struct Accel {
     bvh: Bvh4,
-    prims: Vec<Prim>,
-    /// (shape index, triangle index within the shape) per primitive, in leaf order.
+    leaves: Vec<Leaf>,
+    /// (centre, radius, index in `refs`).
+    spheres: Vec<(Vec3, f32, u32)>,
+    /// (shape index, triangle index within the shape) per primitive.
     refs: Vec<(u32, u32)>,
+}
+
+/// A primitive before it is placed in a leaf.
+enum Prim {
+    Tri([Vec3; 3]),
+    Sphere(Vec3, f32),
 }
 
 impl Accel {
@@ -36,96 +52,106 @@ impl Accel {
                         if (b - a).cross(c - a).length_squared() == 0.0 {
                             continue;
                         }
-                        let v = [a, b, c].map(Vec3A::from);
-                        prims.push(Prim::Tri { v });
+                        prims.push(Prim::Tri([a, b, c]));
                         refs.push((si as u32, ti as u32));
-                        aabbs.push(Aabb::from_points(&v));
+                        aabbs.push(Aabb::from_points(&[a, b, c].map(Vec3A::from)));
                     }
                 }
                 ShapeKind::Sphere(s) => {
-                    let (c, r) = (s.center, s.radius);
-                    prims.push(Prim::Sphere { c, r });
+                    prims.push(Prim::Sphere(s.center, s.radius));
                     refs.push((si as u32, 0));
-                    let r = Vec3A::splat(r);
-                    let c: Vec3A = c.into();
+                    let (c, r): (Vec3A, _) = (s.center.into(), Vec3A::splat(s.radius));
                     aabbs.push(Aabb::new(c - r, c + r));
                 }
             }
         }
+        let mut accel = Accel {
+            bvh: Bvh4::empty(),
+            leaves: Vec::new(),
+            spheres: Vec::new(),
+            refs,
+        };
         if prims.is_empty() {
-            return Accel {
-                bvh: Bvh4::empty(),
-                prims,
-                refs,
-            };
+            return accel;
         }
         let params = BvhBuildParams {
-            max_prims_per_leaf: 4.min(MAX_LEAF),
+            max_prims_per_leaf: LEAF_SIZE as u32,
             ..BvhBuildParams::medium_build()
         };
         let bvh2 = build_bvh2(&aabbs, params, &mut Duration::default());
-        let order = &bvh2.primitive_indices;
-        Accel {
-            bvh: Bvh4::from_bvh2(&bvh2),
-            prims: order.iter().map(|&i| prims[i as usize]).collect(),
-            refs: order.iter().map(|&i| refs[i as usize]).collect(),
+        accel.bvh = Bvh4::from_bvh2(&bvh2);
+        for &(first, count) in accel.bvh.leaves() {
+            let ids = &bvh2.primitive_indices[first as usize..(first + count) as usize];
+            assert!(
+                ids.len() <= LEAF_SIZE,
+                "BVH leaf of {} primitives",
+                ids.len()
+            );
+            let mut tris = Vec::new();
+            let mut tri_ref = [0; 4];
+            let s0 = accel.spheres.len() as u32;
+            for &id in ids {
+                match prims[id as usize] {
+                    Prim::Tri(v) => {
+                        tri_ref[tris.len()] = id;
+                        tris.push(v);
+                    }
+                    Prim::Sphere(c, r) => accel.spheres.push((c, r, id)),
+                }
+            }
+            let n_tris = tris.len() as u32;
+            if tris.is_empty() {
+                tris.push([Vec3::ZERO; 3]);
+            }
+            for lane in n_tris as usize..4 {
+                tri_ref[lane] = tri_ref[0];
+            }
+            accel.leaves.push(Leaf {
+                tris: Tri4::new(&tris),
+                tri_ref,
+                n_tris,
+                spheres: (s0, accel.spheres.len() as u32),
+            });
         }
+        accel
     }
 
     pub fn primitive_count(&self) -> usize {
-        self.prims.len()
-    }
-
-    /// Distance to primitive `i` (infinite on a miss) and, for triangles, barycentrics.
-    #[inline(always)]
-    fn prim_hit(
-        &self,
-        i: usize,
-        wr: &WatertightRay,
-        o: Vec3,
-        d: Vec3,
-        tmin: f32,
-        tmax: f32,
-    ) -> (f32, Vec2) {
-        match self.prims[i] {
-            Prim::Tri { v: [a, b, c] } => wr
-                .intersect(a, b, c, tmin, tmax)
-                .map_or((f32::INFINITY, Vec2::ZERO), |h| (h.0, Vec2::new(h.1, h.2))),
-            Prim::Sphere { c, r } => (
-                intersect_sphere(o, d, tmin, tmax, c, r).unwrap_or(f32::INFINITY),
-                Vec2::ZERO,
-            ),
-        }
-    }
-
-    #[inline(always)]
-    fn prim_t(&self, i: usize, wr: &WatertightRay, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> f32 {
-        self.prim_hit(i, wr, o, d, tmin, tmax).0
+        self.refs.len()
     }
 
     /// Closest hit within the ray's interval.
     pub fn intersect(&self, ray: &Ray, shapes: &[Shape]) -> Option<Hit> {
         let (o, d, tmin) = (ray.o, ray.d, ray.tmin);
         let wr = WatertightRay::new(o, d);
-        // The barycentrics of the current best ride along.
-        let mut best_bary = Vec2::ZERO;
-        let (i, t) = self.bvh.closest(
+        // The best primitive and its barycentrics ride along.
+        let mut best = (0u32, Vec2::ZERO);
+        let t = self.bvh.closest(
             o,
             d,
             tmin,
             ray.tmax,
             #[inline(always)]
-            |i, tmax| {
-                let (t, bary) = self.prim_hit(i, &wr, o, d, tmin, tmax);
-                if t < tmax {
-                    best_bary = bary;
+            |l, mut tmax| {
+                let leaf = &self.leaves[l];
+                if leaf.n_tris > 0 {
+                    if let Some((lane, t, b1, b2)) = wr.closest(&leaf.tris, tmin, tmax) {
+                        tmax = t;
+                        best = (leaf.tri_ref[lane], Vec2::new(b1, b2));
+                    }
                 }
-                t
+                for &(c, r, id) in &self.spheres[leaf.spheres.0 as usize..leaf.spheres.1 as usize] {
+                    if let Some(t) = intersect_sphere(o, d, tmin, tmax, c, r) {
+                        tmax = t;
+                        best = (id, Vec2::ZERO);
+                    }
+                }
+                tmax
             },
         )?;
-        let (shape, local) = self.refs[i];
+        let (shape, local) = self.refs[best.0 as usize];
         let sp = match &shapes[shape as usize].kind {
-            ShapeKind::Mesh(m) => m.surface_point(local as usize, best_bary, shape),
+            ShapeKind::Mesh(m) => m.surface_point(local as usize, best.1, shape),
             ShapeKind::Sphere(s) => s.surface_point(ray.o + ray.d * t, shape),
         };
         Some(Hit { t, sp })
@@ -141,7 +167,13 @@ impl Accel {
             tmin,
             tmax,
             #[inline(always)]
-            |i, tmax| self.prim_t(i, &wr, o, d, tmin, tmax),
+            |l, tmax| {
+                let leaf = &self.leaves[l];
+                (leaf.n_tris > 0 && wr.any(&leaf.tris, tmin, tmax))
+                    || self.spheres[leaf.spheres.0 as usize..leaf.spheres.1 as usize]
+                        .iter()
+                        .any(|&(c, r, _)| intersect_sphere(o, d, tmin, tmax, c, r).is_some())
+            },
         )
     }
 }
@@ -149,6 +181,7 @@ impl Accel {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::watertight::intersect_triangle;
     use crate::geometry::{Mesh, Sphere};
     use crate::rng::Rng;
 
@@ -198,10 +231,19 @@ mod tests {
             let o = Vec3::new(rng.next_f32() * 1.4 - 0.2, rng.next_f32() * 1.4 - 0.2, 2.0);
             let d = Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, -1.0).normalize();
             let ray = Ray::new(o, d);
-            let wr = WatertightRay::new(o, d);
-            let brute = (0..accel.prims.len())
-                .map(|i| accel.prim_t(i, &wr, o, d, 0.0, f32::INFINITY))
-                .fold(f32::INFINITY, f32::min);
+            let inf = f32::INFINITY;
+            let brute = shapes
+                .iter()
+                .flat_map(|s| match &s.kind {
+                    ShapeKind::Mesh(m) => (0..m.indices.len())
+                        .map(|t| intersect_triangle(o, d, 0.0, inf, m.vertices(t)).map(|h| h.0))
+                        .collect::<Vec<_>>(),
+                    ShapeKind::Sphere(s) => {
+                        vec![intersect_sphere(o, d, 0.0, inf, s.center, s.radius)]
+                    }
+                })
+                .flatten()
+                .fold(inf, f32::min);
             match accel.intersect(&ray, &shapes) {
                 Some(h) => {
                     hits += 1;

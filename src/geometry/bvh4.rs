@@ -10,13 +10,10 @@
 use glam::{Vec3, Vec4};
 use obvhs::{aabb::Aabb, bvh2::Bvh2};
 
-/// Child slot tags: a leaf is `LEAF | first << COUNT_BITS | count`, an internal child is its
-/// node index, an empty slot is `EMPTY` (its box is inverted so it is never entered).
+/// Child slot tags: a leaf is `LEAF | leaf index`, an internal child is its node index, an
+/// empty slot is `EMPTY` (its box is inverted so it is never entered).
 const LEAF: u32 = 1 << 31;
-const COUNT_BITS: u32 = 4;
 const EMPTY: u32 = u32::MAX;
-/// Largest primitive count of a leaf (obvhs's collapse is asked for at most this many).
-pub const MAX_LEAF: u32 = (1 << COUNT_BITS) - 1;
 /// pbrt-v4's 1 + 2 gamma(3): the slab test's far distances are scaled by it.
 const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 /// Stack entries the traversal keeps on its own stack; deeper trees use a heap stack.
@@ -32,6 +29,8 @@ struct Node {
 
 pub struct Bvh4 {
     nodes: Vec<Node>,
+    /// Per leaf: its first position in the binary BVH's `primitive_indices` and its count.
+    leaves: Vec<(u32, u32)>,
     /// Stack entries a traversal may need: three per level below the root, plus one.
     stack_need: usize,
 }
@@ -84,12 +83,12 @@ impl Bvh4 {
     pub fn empty() -> Bvh4 {
         Bvh4 {
             nodes: Vec::new(),
+            leaves: Vec::new(),
             stack_need: 1,
         }
     }
 
-    /// Collapses a binary BVH whose leaves hold at most `MAX_LEAF` primitives. Leaves refer to
-    /// positions in `bvh.primitive_indices`.
+    /// Collapses a binary BVH. Leaves are numbered in the order `leaves()` lists them.
     pub fn from_bvh2(bvh: &Bvh2) -> Bvh4 {
         let mut out = Bvh4::empty();
         if bvh.nodes.is_empty() {
@@ -141,12 +140,8 @@ impl Bvh4 {
         for (lane, &k) in kids.iter().enumerate() {
             let n = &bvh.nodes[k];
             let child = if n.is_leaf() {
-                assert!(n.prim_count <= MAX_LEAF, "leaf of {} prims", n.prim_count);
-                assert!(
-                    n.first_index < 1 << (31 - COUNT_BITS),
-                    "too many primitives"
-                );
-                LEAF | n.first_index << COUNT_BITS | n.prim_count
+                self.leaves.push((n.first_index, n.prim_count));
+                LEAF | (self.leaves.len() - 1) as u32
             } else {
                 let c = self.nodes.len() as u32;
                 depth = depth.max(1 + self.collapse(bvh, k, false));
@@ -166,8 +161,13 @@ impl Bvh4 {
         depth
     }
 
-    /// Closest hit in (tmin, tmax): `prim(i, tmax)` returns the distance to primitive `i` if it
-    /// is hit inside (tmin, tmax), else infinity. Returns the primitive and its distance.
+    /// Per leaf: its first position in the binary BVH's `primitive_indices` and its count.
+    pub fn leaves(&self) -> &[(u32, u32)] {
+        &self.leaves
+    }
+
+    /// Distance to the closest hit in (tmin, tmax): `leaf(i, tmax)` returns the distance to the
+    /// closest hit in leaf `i` inside (tmin, tmax), else infinity.
     #[inline(always)]
     pub fn closest<F: FnMut(usize, f32) -> f32>(
         &self,
@@ -175,34 +175,33 @@ impl Bvh4 {
         d: Vec3,
         tmin: f32,
         tmax: f32,
-        prim: F,
-    ) -> Option<(usize, f32)> {
+        leaf: F,
+    ) -> Option<f32> {
         if self.stack_need <= STACK {
             let mut stack = [(0u32, 0f32); STACK];
-            self.closest_with(&mut stack, o, d, tmin, tmax, prim)
+            self.closest_with(&mut stack, o, d, tmin, tmax, leaf)
         } else {
             let mut stack = vec![(0u32, 0f32); self.stack_need];
-            self.closest_with(&mut stack, o, d, tmin, tmax, prim)
+            self.closest_with(&mut stack, o, d, tmin, tmax, leaf)
         }
     }
 
-    /// True if `prim(i, tmax)` reports a hit (a finite distance) for any primitive whose box
-    /// the ray enters.
+    /// True if `leaf(i, tmax)` reports a hit for any leaf whose box the ray enters.
     #[inline(always)]
-    pub fn any<F: FnMut(usize, f32) -> f32>(
+    pub fn any<F: FnMut(usize, f32) -> bool>(
         &self,
         o: Vec3,
         d: Vec3,
         tmin: f32,
         tmax: f32,
-        prim: F,
+        leaf: F,
     ) -> bool {
         if self.stack_need <= STACK {
             let mut stack = [0u32; STACK];
-            self.any_with(&mut stack, o, d, tmin, tmax, prim)
+            self.any_with(&mut stack, o, d, tmin, tmax, leaf)
         } else {
             let mut stack = vec![0u32; self.stack_need];
-            self.any_with(&mut stack, o, d, tmin, tmax, prim)
+            self.any_with(&mut stack, o, d, tmin, tmax, leaf)
         }
     }
 
@@ -214,8 +213,8 @@ impl Bvh4 {
         d: Vec3,
         tmin: f32,
         mut tmax: f32,
-        mut prim: F,
-    ) -> Option<(usize, f32)> {
+        mut leaf: F,
+    ) -> Option<f32> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -248,13 +247,10 @@ impl Bvh4 {
                     continue;
                 }
             } else {
-                let first = ((cur & !LEAF) >> COUNT_BITS) as usize;
-                for i in first..first + (cur & MAX_LEAF) as usize {
-                    let t = prim(i, tmax);
-                    if t < tmax {
-                        tmax = t;
-                        best = Some((i, t));
-                    }
+                let t = leaf((cur & !LEAF) as usize, tmax);
+                if t < tmax {
+                    tmax = t;
+                    best = Some(t);
                 }
             }
             // Next waiting child still entered before the current closest hit.
@@ -272,14 +268,14 @@ impl Bvh4 {
     }
 
     #[inline(always)]
-    fn any_with<F: FnMut(usize, f32) -> f32>(
+    fn any_with<F: FnMut(usize, f32) -> bool>(
         &self,
         stack: &mut [u32],
         o: Vec3,
         d: Vec3,
         tmin: f32,
         tmax: f32,
-        mut prim: F,
+        mut leaf: F,
     ) -> bool {
         if self.nodes.is_empty() {
             return false;
@@ -297,13 +293,8 @@ impl Bvh4 {
                     stack[sp] = n.child[lane];
                     sp += 1;
                 }
-            } else {
-                let first = ((cur & !LEAF) >> COUNT_BITS) as usize;
-                for i in first..first + (cur & MAX_LEAF) as usize {
-                    if prim(i, tmax) < tmax {
-                        return true;
-                    }
-                }
+            } else if leaf((cur & !LEAF) as usize, tmax) {
+                return true;
             }
             if sp == 0 {
                 return false;
@@ -357,8 +348,8 @@ mod tests {
                     if c == EMPTY {
                         assert!(node.b[0][lane] > node.b[1][lane]);
                     } else if c & LEAF != 0 {
-                        let first = ((c & !LEAF) >> COUNT_BITS) as usize;
-                        for p in first..first + (c & MAX_LEAF) as usize {
+                        let (first, count) = bvh4.leaves[(c & !LEAF) as usize];
+                        for p in first as usize..(first + count) as usize {
                             seen[p] += 1;
                             let b = aabbs[bvh2.primitive_indices[p] as usize];
                             assert!(node.b[0][lane] <= b.min.x && b.max.x <= node.b[1][lane]);
@@ -424,12 +415,19 @@ mod tests {
                     f32::INFINITY
                 }
             };
+            let leaf = |l: usize, tmax: f32| {
+                let (first, count) = bvh4.leaves()[l];
+                (first..first + count)
+                    .map(|i| prim(i as usize, tmax))
+                    .fold(f32::INFINITY, f32::min)
+            };
             let brute = (0..aabbs.len())
                 .map(|i| prim(i, tmax))
                 .fold(f32::INFINITY, f32::min);
-            let got = bvh4.closest(o, d, tmin, tmax, prim).map(|h| h.1);
+            let got = bvh4.closest(o, d, tmin, tmax, leaf);
             assert_eq!(got.unwrap_or(f32::INFINITY), brute, "ray {k}");
-            assert_eq!(bvh4.any(o, d, tmin, tmax, prim), brute.is_finite());
+            let any = bvh4.any(o, d, tmin, tmax, |l, tmax| leaf(l, tmax) < tmax);
+            assert_eq!(any, brute.is_finite());
         }
     }
 }

@@ -4,6 +4,7 @@ pub mod accel;
 mod bvh4;
 mod refine;
 pub mod shape;
+pub mod watertight;
 
 pub use accel::Accel;
 pub use shape::{Mesh, Shape, ShapeKind, Sphere};

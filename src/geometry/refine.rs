@@ -60,7 +60,8 @@ fn permute_d(v: DVec3, kz: u8) -> DVec3 {
 
 #[cfg(test)]
 mod tests {
-    use crate::geometry::shape::{intersect_triangle, Mesh};
+    use crate::geometry::shape::Mesh;
+    use crate::geometry::watertight::intersect_triangle;
     use crate::rng::Rng;
     use crate::sampling::warps::square_to_uniform_sphere;
     use glam::Vec3;

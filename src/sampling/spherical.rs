@@ -206,7 +206,8 @@ mod tests {
             for _ in 0..n {
                 let (w, pdf) = sample_spherical_triangle(p, v, rng.next_2d()).unwrap();
                 s += 1.0 / pdf as f64;
-                let hit = crate::geometry::shape::intersect_triangle(p, w, 0.0, f32::INFINITY, v);
+                let hit =
+                    crate::geometry::watertight::intersect_triangle(p, w, 0.0, f32::INFINITY, v);
                 let b = ray_plane_barycentrics(p, w, v).unwrap();
                 assert!(
                     hit.is_some() || b.x.min(b.y).min(1.0 - b.x - b.y) < 1e-4,
