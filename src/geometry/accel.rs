@@ -121,7 +121,20 @@ impl Accel {
     }
 
     /// Closest hit within the ray's interval.
+    #[inline]
     pub fn intersect(&self, ray: &Ray, shapes: &[Shape]) -> Option<Hit> {
+        self.intersect_if(ray, shapes, |_| true)
+    }
+
+    /// Closest hit within the ray's interval if `keep(shape index)`; the surface point is
+    /// only built for kept hits (a BSDF sample needs it only where it hits an emitter).
+    #[inline(always)]
+    pub fn intersect_if(
+        &self,
+        ray: &Ray,
+        shapes: &[Shape],
+        keep: impl Fn(usize) -> bool,
+    ) -> Option<Hit> {
         let (o, d, tmin) = (ray.o, ray.d, ray.tmin);
         let wr = WatertightRay::new(o, d);
         // The best primitive and its barycentrics ride along.
@@ -150,6 +163,9 @@ impl Accel {
             },
         )?;
         let (shape, local) = self.refs[best.0 as usize];
+        if !keep(shape as usize) {
+            return None;
+        }
         let sp = match &shapes[shape as usize].kind {
             ShapeKind::Mesh(m) => m.surface_point(local as usize, best.1, shape),
             ShapeKind::Sphere(s) => s.surface_point(ray.o + ray.d * t, shape),

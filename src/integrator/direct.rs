@@ -185,7 +185,7 @@ impl<'a> Direct<'a> {
         };
         let d = sh.frame.to_world(bs.wo);
         let ray = Ray::new(sh.sp.spawn_origin(d), d);
-        let Some(hit) = scene.intersect(&ray) else {
+        let Some(hit) = scene.intersect_emitter(&ray) else {
             return Rgb::ZERO;
         };
         let Some((ei, e)) = scene.emitter_at(&hit.sp) else {

@@ -284,6 +284,14 @@ impl Scene {
         self.accel.intersect(ray, &self.shapes)
     }
 
+    /// The closest hit if it lies on an emitter.
+    #[inline]
+    pub fn intersect_emitter(&self, ray: &Ray) -> Option<Hit> {
+        let shapes = &self.shapes;
+        self.accel
+            .intersect_if(ray, shapes, |s| shapes[s].emitter.is_some())
+    }
+
     /// Mutual visibility of a surface point and a point on a light. Both ends are moved off
     /// their surfaces and the shadow ray stops just short of the light, so neither the
     /// receiver nor the light itself counts as a blocker.
