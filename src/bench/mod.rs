@@ -111,6 +111,28 @@ fn throughput(
 }
 
 /// Peak resident memory of this process in bytes (Linux), if known.
+/// Nanoseconds per emitter choice (one uniform number in, emitter and pmf out), best of 3
+/// runs of 2^22 choices. The numbers jump around the unit interval (golden-ratio sequence) as
+/// a render's do, so table lookups are not sequential.
+fn choice_ns(scene: &crate::scene::Scene, sel: EmitterSelection) -> f64 {
+    let selector = crate::emitter::EmitterSelector::new(&scene.emitters, sel);
+    let n = 1u32 << 22;
+    (0..3)
+        .map(|_| {
+            let start = std::time::Instant::now();
+            let mut sink = 0usize;
+            for i in 0..n {
+                let u = std::hint::black_box((i as f64 * 0.618_033_988_749_895).fract() as f32);
+                if let Some((e, pmf)) = selector.sample(u) {
+                    sink = sink.wrapping_add(e).wrapping_add(pmf.to_bits() as usize);
+                }
+            }
+            std::hint::black_box(sink);
+            start.elapsed().as_secs_f64() * 1e9 / n as f64
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 fn peak_memory() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
@@ -233,6 +255,22 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                 n: n as u64,
                 value: 1e9 / sps,
                 unit: "ns/sample",
+            });
+            // The choice alone: the render's cost above also grows with the BVH (n lights are
+            // 2n more triangles), which is not the selector's doing.
+            let ns = choice_ns(&scene, sel);
+            println!(
+                "  {:>9} emitters ({:?} choice alone): {:>8.2} ns/choice",
+                n, sel, ns
+            );
+            rows.push(Row {
+                section: "emitter_choice",
+                scene: "floor under a grid of quad lights".into(),
+                strategy: format!("{sel:?}").to_lowercase(),
+                threads: 1,
+                n: n as u64,
+                value: ns,
+                unit: "ns/choice",
             });
         }
     }
