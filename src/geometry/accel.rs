@@ -1,7 +1,7 @@
-//! The scene's acceleration structure: one 4-wide BVH (see `bvh4`) whose leaves hold up to
+//! The scene's acceleration structure: one 8-wide BVH (see `bvh`) whose leaves hold up to
 //! four triangles as one SIMD packet (see `watertight`), plus any spheres.
 
-use super::bvh4::Bvh4;
+use super::bvh::WideBvh;
 use super::shape::{intersect_sphere, Shape, ShapeKind};
 use super::watertight::{Tri4, WatertightRay};
 use super::{Hit, Ray};
@@ -24,7 +24,7 @@ struct Leaf {
 }
 
 pub struct Accel {
-    bvh: Bvh4,
+    bvh: WideBvh,
     leaves: Vec<Leaf>,
     /// (centre, radius, index in `refs`).
     spheres: Vec<(Vec3, f32, u32)>,
@@ -66,7 +66,7 @@ impl Accel {
             }
         }
         let mut accel = Accel {
-            bvh: Bvh4::empty(),
+            bvh: WideBvh::empty(),
             leaves: Vec::new(),
             spheres: Vec::new(),
             refs,
@@ -79,7 +79,7 @@ impl Accel {
             ..BvhBuildParams::medium_build()
         };
         let bvh2 = build_bvh2(&aabbs, params, &mut Duration::default());
-        accel.bvh = Bvh4::from_bvh2(&bvh2);
+        accel.bvh = WideBvh::from_bvh2(&bvh2);
         for &(first, count) in accel.bvh.leaves() {
             let ids = &bvh2.primitive_indices[first as usize..(first + count) as usize];
             assert!(

@@ -1,7 +1,7 @@
 //! Geometry: shapes in world space, their intersection, and the BVH over all of them.
 
 pub mod accel;
-mod bvh4;
+mod bvh;
 mod refine;
 pub mod shape;
 pub mod watertight;

