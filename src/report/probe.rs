@@ -1,45 +1,12 @@
-//! `reports/extreme/index.md` and `extreme.csv`.
-//!
-//! Plugging into the experiment runner (issue 5): each case is a (scene, reference) pair and
-//! each row a (case, strategy) measurement, so the runner's results table can hold the rows
-//! as they are; what the runner lacks is the per-sample statistics (max sample, top-0.1 %
-//! share), which come from `samples::pixel_samples` and `measure::measure` and need no image.
+//! `index.md` of a probe experiment (such as `reports/extreme/`): settings, cases, the
+//! per-case, per-strategy table (non-finite samples, bias z, relMSE, largest sample,
+//! fireflies' share, slope, verdict), the accumulation check and the input checks.
 
-use super::accumulate::Accumulation;
-use super::cases::{emitter_count, Case};
-use super::invalid::Outcome;
-use super::measure::RELMSE_SPP;
-use super::measure::{z_critical, ALPHA};
-use super::Row;
+pub use super::probe_table::{critical, table, table_spp, TableRow, BIASED, NON_FINITE, OK, TAIL};
+use crate::experiment::analysis::metric_name;
+use crate::experiment::probe::ProbeOutcome;
+use crate::film::write_atomic;
 use std::fmt::Write as _;
-use std::path::Path;
-
-/// The defects the contact cases exposed, and their fixes; before them every strategy but
-/// area-sampled light sampling was biased by 10-100 % there (|z| up to 1e6).
-const DEFECTS: &str = "\
-1. **Spawn offset larger than the gap.** Ray origins were pushed off a surface by 1.9e-6 \
-   times its vertices' largest coordinate, one scalar for all axes: on a floor of size 1 the \
-   origin landed above a light 1e-6 over it, so BSDF samples never reached the light (BSDF \
-   sampling rendered 0). The bound is now per component, as pbrt-v4's: a floor at z = 0 has \
-   no error in z, whatever its size (`math::offset_origin`).
-2. **The triangle test's f32 error bound hid near geometry.** pbrt-v4's bound on the hit \
-   distance grows with the vertices' distance from the ray origin, so hits 1e-6 of the scene \
-   away were dropped as possible self-hits (28 % of BSDF rays under the contact light), and \
-   a shadow ray ending 1e-7 short of a light with far vertices \"hit\" that light at \
-   t = 0.99 (8 % of light samples at scale 1e5). Hits the f32 bound cannot place against 0, \
-   tmin or tmax are now re-decided in f64 (`geometry::refine`); the inside test stays f32, \
-   so shared edges stay watertight.
-3. **Spherical-triangle sampling in f32.** Seen from a receiver under an edge of a light \
-   1e-6 away, two vertex directions are nearly opposite and the arc normal a × b cancels: the \
-   sampled directions and 1/Ω were off by 20-100 %. The spherical triangle is now computed in \
-   f64 (`sampling::spherical`).";
-
-pub struct RunInfo {
-    pub samples: u32,
-    pub seed: u64,
-    pub quick: bool,
-    pub seconds: f64,
-}
 
 fn sci(x: f64) -> String {
     if x.is_nan() {
@@ -51,224 +18,259 @@ fn sci(x: f64) -> String {
     }
 }
 
-fn fixed(x: f64, digits: usize) -> String {
-    if x.is_nan() {
-        "—".into()
-    } else {
-        format!("{x:.digits$}")
-    }
+fn settings(md: &mut String, o: &ProbeOutcome, rows: usize) {
+    let x = &o.exp.exp;
+    let p = x.probe.as_ref().expect("probe mode");
+    let spp = table_spp(o);
+    let zc = critical(o, rows);
+    let _ = writeln!(md, "## Settings\n");
+    let _ = writeln!(
+        md,
+        "- Experiment file: `{}`{}; {} cases, {} strategies listed.",
+        o.exp.file.display(),
+        if o.exp.quick { " (`--quick`)" } else { "" },
+        o.cases.len(),
+        x.strategies.len()
+    );
+    let _ = writeln!(
+        md,
+        "- Probe: **{}** samples of pixel ({}, {}) per (case, strategy, seed), drawn exactly as \
+         `render` draws them; seeds 0..{}.",
+        p.samples, p.pixel[0], p.pixel[1], x.seeds
+    );
+    let _ = writeln!(
+        md,
+        "- Error: {} of the means of batches of k samples, averaged over the samples / k \
+         independent batches, for k in {:?} (one row of `results.csv` each); the table shows \
+         k = {spp}. The reference is the case's closed form, without noise.",
+        metric_name(x.metrics.primary, x.metrics.relmse_epsilon),
+        x.spp
+    );
+    let _ = writeln!(
+        md,
+        "- Bias: z = (mean - reference) / standard error (its f32 rounding floor, 1e-6 relative, \
+         included); |z| < {zc:.2} passes (two-sided, family-wise alpha = {} Šidák-corrected \
+         over the {rows} rows).",
+        p.alpha
+    );
+    let _ = writeln!(
+        md,
+        "- This invocation drew {} of {} streams ({} came from `results.csv`{}) in {:.1} s.\n",
+        o.drawn,
+        o.streams,
+        o.streams - o.drawn,
+        if o.dropped_rows > 0 {
+            format!("; {} outdated rows were dropped", o.dropped_rows)
+        } else {
+            String::new()
+        },
+        o.seconds
+    );
+    let _ = writeln!(
+        md,
+        "Columns: non-finite samples (must be 0); mean and its z; relMSE at {spp} spp; the \
+         largest single sample; the share of the total squared error carried by the top 0.1 % \
+         of samples (fireflies; ~0.3 % for a well-behaved estimator); the least-squares slope \
+         of log error against log spp over the sweep (-1 expected; — where the error is 0). \
+         Verdict: `ok` = finite and |z| below the critical value; `tail unsampled` = |z| too \
+         large with the mean too low, and either over half the squared error in 0.1 % of the \
+         samples (the sample variance underestimates the true one, so z is not evidence of \
+         bias) or a pure technique the case declares blind to part of the integrand (reason \
+         given); `BIASED` = anything else.\n"
+    );
 }
 
-/// What a row shows: finite and unbiased, or why the z-test cannot be read as bias. A mean
-/// too low with most squared error in 0.1 % of the samples, or from a technique the case
-/// declares blind, is an unsampled tail: the sample variance underestimates the true one.
-pub fn verdict(r: &Row, zc: f64) -> &'static str {
-    if r.m.non_finite > 0 {
-        "NON-FINITE"
-    } else if r.m.z.abs() < zc {
-        "ok"
-    } else if r.m.z < 0.0 && (r.blind.is_some() || r.m.top_share > 0.5) {
-        "tail unsampled"
-    } else {
-        "BIASED"
-    }
-}
-
-pub fn write_csv(path: &Path, rows: &[Row]) -> Result<(), String> {
-    let mut w = csv::Writer::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let head = [
-        "case",
-        "group",
-        "strategy",
-        "reference",
-        "reference_from",
-        "samples",
-        "non_finite",
-        "mean",
-        "z",
-        "rel_mse_at_1024spp",
-        "max_sample",
-        "top_0.1pct_share",
-        "slope",
-    ];
-    w.write_record(head).map_err(|e| e.to_string())?;
-    for r in rows {
-        let m = &r.m;
-        w.write_record([
-            r.case.clone(),
-            r.group.to_string(),
-            r.strategy.label(),
-            format!("{:e}", r.reference),
-            r.reference_from.to_string(),
-            m.n.to_string(),
-            m.non_finite.to_string(),
-            format!("{:e}", m.mean),
-            format!("{}", m.z),
-            format!("{:e}", m.rel_mse),
-            format!("{:e}", m.max_sample),
-            format!("{}", m.top_share),
-            format!("{}", m.slope),
-        ])
-        .map_err(|e| e.to_string())?;
-    }
-    w.flush().map_err(|e| e.to_string())
-}
-
-pub fn write_index(
-    path: &Path,
-    info: &RunInfo,
-    cases: &[Case],
-    rows: &[Row],
-    acc: &[Accumulation],
-    invalid: &[Outcome],
-) -> Result<(), String> {
-    let zc = z_critical(ALPHA, rows.len());
-    let mut s = String::new();
-    let w = &mut s;
+fn cases(md: &mut String, o: &ProbeOutcome) {
+    let _ = writeln!(md, "## Cases\n");
     let _ = writeln!(
-        w,
-        "# Extreme cases: finiteness, bias and variance per strategy\n"
+        md,
+        "| case | group | scene | emitters | reference | from | what it stresses |"
     );
-    let _ = writeln!(
-        w,
-        "Generated by `directlab extreme{}` (seed {}, {:.0} s). Issue 6. Every probe is one \
-         pixel looking at a point of a floor (z = 0) whose outgoing radiance is known in \
-         closed form (Lambert's polygon formula on the rendered f32 vertices, Fresnel for \
-         (near-)specular lobes wholly inside a light) or by a 1024² quadrature over the light \
-         (alpha = 1).\n",
-        if info.quick { " --quick" } else { "" },
-        info.seed,
-        info.seconds
-    );
-    let _ = writeln!(
-        w,
-        "**{}** samples per (case, strategy), drawn exactly as `render` draws pixel (0, 0). \
-         Columns: non-finite samples (must be 0); mean and its z against the reference \
-         (|z| < {zc:.2} passes: two-sided, family-wise alpha = {ALPHA} Šidák-corrected over \
-         the {} rows); relMSE at {RELMSE_SPP} spp, averaged over the independent batches of \
-         {RELMSE_SPP} samples (absolute MSE where the reference is 0); the largest single \
-         sample; the share of the total squared error carried by the top 0.1 % of samples \
-         (fireflies; ~0.3 % for a well-behaved estimator); the least-squares slope of log \
-         MSE against log spp over spp = 1, 2, 4, … with at least 32 batches per point (-1 \
-         expected).\n",
-        info.samples,
-        rows.len()
-    );
-    let _ = writeln!(
-        w,
-        "Verdict: `ok` = finite and |z| below the critical value; `tail unsampled` = |z| \
-         too large but over half the squared error sits in 0.1 % of the samples: the sample \
-         variance underestimates the true one, so z is not evidence of bias (the estimator \
-         needs far more samples there), and so is a mean too low from a pure technique the \
-         case declares blind to part of the integrand (reason given); `BIASED` = anything \
-         else.\n"
-    );
-    let _ = writeln!(w, "![relMSE against spp](convergence.png)\n");
-    let _ = writeln!(
-        w,
-        "## Renderer defects this suite found (fixed)\n\n{DEFECTS}\n"
-    );
-    let _ = writeln!(w, "## Cases\n");
-    let _ = writeln!(
-        w,
-        "| case | group | emitters | reference | from | what it stresses |"
-    );
-    let _ = writeln!(w, "|---|---|---|---|---|---|");
-    for c in cases {
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
+    for c in &o.cases {
+        let file = c
+            .case
+            .scene
+            .file_name()
+            .map_or(String::new(), |f| f.to_string_lossy().to_string());
+        let defines: Vec<String> = c
+            .case
+            .defines
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect();
         let _ = writeln!(
-            w,
-            "| {} | {} | {} | {} | {} | {} |",
-            c.name,
-            c.group,
-            emitter_count(&c.desc),
-            sci(c.reference),
-            c.reference_from,
-            c.about
+            md,
+            "| {} | {} | `{file}`{} | {} | {} | {} | {} |",
+            c.case.name,
+            c.case.group,
+            if defines.is_empty() {
+                String::new()
+            } else {
+                format!(" `-D {}`", defines.join(" -D "))
+            },
+            c.emitters,
+            sci(c.reference()),
+            c.case.reference_from(),
+            c.case.about
         );
     }
-    let _ = writeln!(w, "\n## Results\n");
-    let _ = writeln!(
-        w,
-        "| case | strategy | non-finite | mean | z | relMSE@{RELMSE_SPP} | max sample | top 0.1 % | slope | verdict |"
-    );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|");
-    for r in rows {
-        let m = &r.m;
+    let omitted: Vec<String> = o
+        .cases
+        .iter()
+        .flat_map(|c| {
+            c.omitted
+                .iter()
+                .map(move |om| format!("{}: {} ({})", c.case.name, om.name, om.reason))
+        })
+        .collect();
+    if !omitted.is_empty() {
         let _ = writeln!(
-            w,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {}{} |",
+            md,
+            "\nLeft out as the same estimator as a listed one, or blind to the whole scene \
+             ({}):\n",
+            omitted.len()
+        );
+        for l in omitted {
+            let _ = writeln!(md, "- {l}");
+        }
+    }
+    md.push('\n');
+}
+
+fn results(md: &mut String, o: &ProbeOutcome, t: &[TableRow]) {
+    let spp = table_spp(o);
+    let _ = writeln!(md, "## Results\n");
+    let _ = writeln!(
+        md,
+        "| case | strategy | non-finite | mean | z | relMSE@{spp} | max sample | top 0.1 % | slope | verdict |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
+    for r in t {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {}{} |",
             r.case,
-            r.strategy.label(),
-            m.non_finite,
-            sci(m.mean),
-            fixed(m.z, 2),
-            sci(m.rel_mse),
-            sci(m.max_sample),
-            if m.top_share.is_nan() {
+            r.label,
+            r.non_finite,
+            sci(r.mean),
+            r.z,
+            sci(r.relmse),
+            sci(r.max_sample),
+            if r.top_share.is_nan() {
                 "—".into()
             } else {
-                format!("{:.1} %", 100.0 * m.top_share)
+                format!("{:.1} %", 100.0 * r.top_share)
             },
-            fixed(m.slope, 2),
-            verdict(r, zc),
-            r.blind.map_or(String::new(), |b| format!(" (blind: {b})"))
+            r.slope.map_or("—".into(), |s| format!("{s:.2}")),
+            r.verdict,
+            r.blind
+                .as_ref()
+                .map_or(String::new(), |b| format!(" (blind: {b})"))
         );
     }
-    let total_nf: u64 = rows.iter().map(|r| r.m.non_finite).sum();
-    let count = |v: &str| rows.iter().filter(|r| verdict(r, zc) == v).count();
+    let count = |v: &str| t.iter().filter(|r| r.verdict == v).count();
     let _ = writeln!(
-        w,
+        md,
         "\nSummary: {} rows, {} non-finite samples in all; {} ok, {} tail unsampled, {} biased.\n",
-        rows.len(),
-        total_nf,
-        count("ok"),
-        count("tail unsampled"),
-        count("BIASED")
+        t.len(),
+        t.iter().map(|r| r.non_finite).sum::<u64>(),
+        count(OK),
+        count(TAIL),
+        count(BIASED)
     );
-    let _ = writeln!(w, "## Very high sample counts\n");
+}
+
+fn accumulation(md: &mut String, o: &ProbeOutcome) {
+    if o.accumulation.is_empty() {
+        return;
+    }
+    let _ = writeln!(md, "## Very high sample counts\n");
     let _ = writeln!(
-        w,
-        "`render` on a 2 × 2 probe of the tiny bright light. The image mean's z is against \
-         Lambert; the f64 column is |render mean − exact mean of the same samples| / \
-         reference for pixel (0, 0), the f32 column what a running f32 sum of those samples \
-         would be off by.\n"
+        md,
+        "`render` at very high spp on a small probe. The image mean's z is against the closed \
+         form; the f64 column is |render mean − exact mean of the same samples| / reference for \
+         pixel (0, 0), the f32 column what a running f32 sum of those samples would be off by. \
+         Rows are kept in [accumulation.csv](accumulation.csv).\n"
     );
     let _ = writeln!(
-        w,
+        md,
         "| case | strategy | pixels × spp | non-finite | image mean | reference | z | f64 accumulation error | f32 running sum error |"
     );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|");
-    for a in acc {
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
+    for a in &o.accumulation {
         let _ = writeln!(
-            w,
-            "| {} | {} | {} × {} | {} | {} | {} | {:.2} | {} | {} |",
+            md,
+            "| {} | {} | {} × {} | {} | {:.6e} | {:.6e} | {:.2} | {} | {} |",
             a.case,
             a.strategy,
             a.pixels,
             a.spp,
             a.non_finite,
-            format_args!("{:.6e}", a.image_mean),
-            format_args!("{:.6e}", a.reference),
+            a.image_mean,
+            a.reference,
             a.z,
             sci(a.f64_rel_error),
             sci(a.f32_rel_error)
         );
     }
-    let _ = writeln!(w, "\n## Invalid and degenerate input\n");
-    let _ = writeln!(w, "| input | must give | containing | message | ok |");
-    let _ = writeln!(w, "|---|---|---|---|---|");
-    for o in invalid {
+    md.push('\n');
+}
+
+fn checks(md: &mut String, o: &ProbeOutcome) {
+    if o.checks.is_empty() {
+        return;
+    }
+    let _ = writeln!(md, "## Invalid and degenerate input\n");
+    let _ = writeln!(md, "| input | must give | containing | message | ok |");
+    let _ = writeln!(md, "|---|---|---|---|---|");
+    for c in &o.checks {
         let _ = writeln!(
-            w,
+            md,
             "| {} | {} | {} | {} | {} |",
-            o.input,
-            o.expect,
-            o.must_contain,
-            o.message.replace('|', "\\|").replace('\n', " "),
-            if o.ok { "yes" } else { "NO" }
+            c.input,
+            c.expect,
+            c.must_contain,
+            c.message.replace('|', "\\|").replace('\n', " "),
+            if c.ok { "yes" } else { "NO" }
         );
     }
-    crate::film::write_atomic(path, |tmp| {
-        std::fs::write(tmp, &s).map_err(|e| format!("{}: {e}", path.display()))
+    md.push('\n');
+}
+
+/// Writes `<dir>/index.md`.
+pub fn write(o: &ProbeOutcome, figure: Option<&str>) -> Result<(), String> {
+    let t = table(o);
+    let mut md = String::new();
+    let x = &o.exp.exp;
+    let _ = writeln!(
+        md,
+        "# {}\n",
+        x.title.clone().unwrap_or_else(|| o.exp.name.clone())
+    );
+    if !x.description.is_empty() {
+        let _ = writeln!(md, "{}\n", x.description.trim());
+    }
+    settings(&mut md, o, t.len());
+    if let Some(f) = figure {
+        let _ = writeln!(
+            md,
+            "![{} against spp]({f})\n",
+            crate::experiment::analysis::metric_short(x.metrics.primary)
+        );
+    }
+    cases(&mut md, o);
+    results(&mut md, o, &t);
+    accumulation(&mut md, o);
+    checks(&mut md, o);
+    let _ = writeln!(
+        md,
+        "Raw numbers: [results.csv](results.csv), one row per (case, strategy, seed, spp); \
+         reference values and their closed forms: `{}`.",
+        o.exp.file.display()
+    );
+    let path = o.dir.join("index.md");
+    write_atomic(&path, |tmp| {
+        std::fs::write(tmp, &md).map_err(|err| format!("{}: {err}", path.display()))
     })
 }
