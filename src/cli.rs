@@ -34,8 +34,9 @@ pub enum Command {
     /// Chi-square tests of every sampling routine against its pdf (warps, BSDFs, emitters),
     /// with heat maps; exits non-zero if any case fails.
     Chi2(crate::chi2cases::command::Chi2Args),
-    /// Stability suite of extreme scenes: finiteness, bias and variance per strategy.
-    Extreme(crate::extreme::ExtremeArgs),
+    /// The stability suite of extreme scenes (finiteness, bias and variance per strategy):
+    /// short for `run experiments/extreme.toml`.
+    Extreme(ExtremeArgs),
 }
 
 /// Options shared by `run` and `reproduce`.
@@ -65,6 +66,12 @@ pub struct RunArgs {
     /// Run every experiments/*.toml.
     #[arg(long, conflicts_with = "experiments")]
     pub all: bool,
+    #[command(flatten)]
+    pub sweep: SweepArgs,
+}
+
+#[derive(Args, Debug)]
+pub struct ExtremeArgs {
     #[command(flatten)]
     pub sweep: SweepArgs,
 }
@@ -114,6 +121,11 @@ fn cmd_run(a: &RunArgs) -> Result<(), String> {
     run_files(&files, &a.sweep)
 }
 
+fn cmd_extreme(a: &ExtremeArgs) -> Result<(), String> {
+    let file = crate::experiment::experiments_dir()?.join("extreme.toml");
+    run_files(&[file], &a.sweep)
+}
+
 fn cmd_reproduce(a: &ReproduceArgs) -> Result<(), String> {
     let dir = crate::experiment::experiments_dir()?;
     let files: Vec<PathBuf> = ["fig1", "fig2", "fig3"]
@@ -123,7 +135,7 @@ fn cmd_reproduce(a: &ReproduceArgs) -> Result<(), String> {
     run_files(&files, &a.sweep)
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum StrategyArg {
     Bsdf,
@@ -132,21 +144,21 @@ pub enum StrategyArg {
     MisOnesample,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SelectionArg {
     Uniform,
     Power,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LightSamplingArg {
     Area,
     SolidAngle,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum HeuristicArg {
     Balance,
@@ -352,7 +364,7 @@ pub fn main() -> i32 {
             ok.then_some(())
                 .ok_or_else(|| "some sampling routines do not match their pdfs".to_string())
         }),
-        Command::Extreme(a) => crate::extreme::run(a),
+        Command::Extreme(a) => cmd_extreme(a),
     };
     match r {
         Ok(()) => 0,

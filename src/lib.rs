@@ -11,7 +11,6 @@ pub mod chi2cases;
 pub mod cli;
 pub mod emitter;
 pub mod experiment;
-pub mod extreme;
 pub mod film;
 pub mod geometry;
 pub mod integrator;

@@ -228,6 +228,50 @@ pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, St
     })
 }
 
+/// A closed-form reference: `value` in every pixel and channel, with no noise (floors 0).
+/// `key` should cover the scene, the value and the renderer, as a rendered reference's does,
+/// so that results measured with an older renderer are redone.
+pub fn constant(width: u32, height: u32, value: f64, key: String) -> Reference {
+    let mut mean = Image::new(width, height);
+    mean.data.fill([value; 3]);
+    Reference {
+        mean,
+        variance: Image::new(width, height),
+        info: ReferenceInfo {
+            key,
+            renderer: RENDERER_HASH.to_string(),
+            strategy: "closed form".into(),
+            spp: 0,
+            seed: 0,
+            seconds: 0.0,
+            non_finite_samples: 0,
+            mse_floor: 0.0,
+            relmse_floor: 0.0,
+            relmse_epsilon: 0.0,
+        },
+        cached: true,
+    }
+}
+
+/// Key of a closed-form reference: the scene's key inputs (no render settings) and the value.
+pub fn constant_key(
+    scene: &Path,
+    defines: &[(String, String)],
+    value: f64,
+    base: &Strategy,
+) -> Result<String, String> {
+    let k = reference_key(&KeyInputs {
+        scene,
+        defines,
+        spp: 0,
+        seed: 0,
+        strategy: base,
+    })?;
+    let mut h = Fnv::new();
+    h.field(k.as_bytes()).field(&value.to_le_bytes());
+    Ok(h.hex())
+}
+
 /// Removes references of other keys (an older scene, renderer or setting): one experiment
 /// folder keeps one reference, instead of a growing pile of 5 MB EXRs.
 fn prune(dir: &Path, key: &str) {

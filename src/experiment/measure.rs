@@ -47,6 +47,7 @@ pub(super) fn measure(
     let mean = out.mean.mean_rgb();
     Row {
         context: context.to_string(),
+        case: String::new(),
         strategy: job.strategy.label(),
         name: job.name.clone(),
         kind: job.kind.to_string(),
@@ -73,5 +74,8 @@ pub(super) fn measure(
         mean_var_b: var_sum[2] / (n * n),
         non_finite: out.non_finite_samples,
         near_floor: mse < 2.0 * r.info.mse_floor || relmse < 2.0 * r.info.relmse_floor,
+        z: None,
+        max_sample: None,
+        top_share: None,
     }
 }

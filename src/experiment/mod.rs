@@ -3,21 +3,28 @@
 
 pub mod analysis;
 pub mod cache;
+pub mod cases;
 pub mod figures;
 pub mod leftout;
 mod measure;
 pub mod plan;
+pub mod probe;
 pub mod results;
 pub mod runner;
 pub mod schema;
+mod validate;
 
 pub use runner::{run_experiment, Outcome, RunOptions};
 pub use schema::{load, Resolved};
 use std::path::{Path, PathBuf};
 
-/// Runs one experiment file and writes its figures and report; prints the mean check.
+/// Runs one experiment file and writes its figures and report; prints the mean check (image
+/// sweeps) or the table's summary (probe mode).
 pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(), String> {
     let exp = load(file, quick)?;
+    if exp.exp.probe.is_some() {
+        return probe::run_and_report(exp, opts);
+    }
     let o = run_experiment(exp, opts)?;
     let (series, mut figs) = figures::charts(&o)?;
     figs.extend(figures::images(&o)?);

@@ -39,6 +39,7 @@ pub(super) struct Job {
 /// Two rows are the same run (one replaces the other) if their resume keys agree.
 pub(super) fn same_run(a: &Row, b: &Row) -> bool {
     a.kind == b.kind
+        && a.case == b.case
         && a.strategy == b.strategy
         && a.seed == b.seed
         && if a.is_sweep() {

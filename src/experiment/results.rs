@@ -14,6 +14,9 @@ pub const EQUAL_TIME: &str = "time";
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Row {
     pub context: String,
+    /// The `[[case]]` the row belongs to ("" for a file with one `scene`).
+    #[serde(default)]
+    pub case: String,
     /// Stable label (`Strategy::label`), the resume key; `name` is the legend name.
     pub strategy: String,
     pub name: String,
@@ -53,6 +56,16 @@ pub struct Row {
     pub non_finite: u64,
     /// Measured error within 2x of the reference's noise floor: not trustworthy.
     pub near_floor: bool,
+    /// Probe mode only (empty otherwise), from the individual samples of the whole stream the
+    /// row's batches were cut from: z of its mean against the closed form, ...
+    #[serde(default)]
+    pub z: Option<f64>,
+    /// ... its largest sample, ...
+    #[serde(default)]
+    pub max_sample: Option<f64>,
+    /// ... and the share of its squared error (x - r)^2 carried by its largest 0.1 %.
+    #[serde(default)]
+    pub top_share: Option<f64>,
 }
 
 impl Row {
@@ -79,6 +92,11 @@ pub struct Results {
 impl Results {
     /// Reads `path` keeping the rows of `context`; a missing file is an empty table.
     pub fn load(path: &Path, context: &str) -> Result<Results, String> {
+        Self::load_where(path, |r| r.context == context)
+    }
+
+    /// Reads `path` keeping the rows `keep` accepts.
+    pub fn load_where(path: &Path, keep: impl Fn(&Row) -> bool) -> Result<Results, String> {
         if !path.exists() {
             return Ok(Results {
                 rows: Vec::new(),
@@ -91,7 +109,7 @@ impl Results {
         let mut dropped = 0;
         for r in rd.deserialize::<Row>() {
             match r {
-                Ok(row) if row.context == context => rows.push(row),
+                Ok(row) if keep(&row) => rows.push(row),
                 // Old columns or another context: recompute rather than trust.
                 _ => dropped += 1,
             }
@@ -133,6 +151,7 @@ impl Results {
 pub(crate) fn test_row(strategy: &str, spp: u32, seed: u64) -> Row {
     Row {
         context: "ctx".into(),
+        case: String::new(),
         strategy: strategy.into(),
         name: strategy.into(),
         kind: SWEEP.into(),
@@ -159,6 +178,9 @@ pub(crate) fn test_row(strategy: &str, spp: u32, seed: u64) -> Row {
         mean_var_b: 1e-6,
         non_finite: 0,
         near_floor: false,
+        z: None,
+        max_sample: None,
+        top_share: None,
     }
 }
 
@@ -194,7 +216,7 @@ mod tests {
         assert_eq!(back.find_equal_time("mis", 0.25, 0), Some(&t));
         assert!(back.find_equal_time("mis", 0.5, 0).is_none());
         let header = std::fs::read_to_string(&path).unwrap();
-        assert!(header.starts_with("context,strategy,name,kind,budget_s,spp,seed"));
+        assert!(header.starts_with("context,case,strategy,name,kind,budget_s,spp,seed"));
         assert!(header.lines().next().unwrap().contains("relmse_eps"));
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -16,7 +16,7 @@ use crate::render::{render, RenderSettings};
 use crate::scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 #[derive(Clone, Debug, Default)]
@@ -87,10 +87,60 @@ fn progress_bar(total_samples: u64, runs: usize) -> ProgressBar {
     b
 }
 
+/// The cached reference, or a new render; prints where it came from and its noise floor.
+fn rendered_reference(
+    exp: &Resolved,
+    opts: &RunOptions,
+    scene: &Scene,
+    strategy: Strategy,
+    spp: u32,
+    eps: f64,
+    dir: &Path,
+) -> Result<(String, Reference), String> {
+    let seed = exp.exp.reference.seed;
+    let key = cache::reference_key(&KeyInputs {
+        scene: exp.scene(),
+        defines: exp.defines(),
+        spp,
+        seed,
+        strategy: &strategy,
+    })?;
+    let reference = cache::get_or_render(
+        &dir.join("cache"),
+        &ReferenceRequest {
+            scene,
+            key: key.clone(),
+            strategy,
+            spp,
+            seed,
+            threads: opts.threads,
+            relmse_epsilon: eps,
+            fresh: opts.fresh_reference,
+            progress: std::io::stderr().is_terminal(),
+        },
+    )?;
+    let ri = &reference.info;
+    eprintln!(
+        "{}: reference {} at {} spp ({}, {:.1} s to render); noise floor MSE {:.3e}, relMSE {:.3e}",
+        exp.name,
+        ri.strategy,
+        ri.spp,
+        if reference.cached {
+            "cached"
+        } else {
+            "rendered now"
+        },
+        ri.seconds,
+        ri.mse_floor,
+        ri.relmse_floor
+    );
+    Ok((key, reference))
+}
+
 pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, String> {
     let start = Instant::now();
     let dir = opts.out.join(&exp.name);
-    let scene = open_scene(&exp.scene, &exp.defines)?;
+    let scene = open_scene(exp.scene(), exp.defines())?;
     let base = Strategy::from_desc(&scene.desc.integrator);
     let listed: Vec<(String, Strategy)> = exp
         .exp
@@ -109,44 +159,15 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
     let x = &exp.exp;
     let eps = x.metrics.relmse_epsilon;
     let ref_strategy = x.reference.strategy.apply(base);
-    let key = cache::reference_key(&KeyInputs {
-        scene: &exp.scene,
-        defines: &exp.defines,
-        spp: x.reference.spp,
-        seed: x.reference.seed,
-        strategy: &ref_strategy,
-    })?;
-    let terminal = std::io::stderr().is_terminal();
-    let reference = cache::get_or_render(
-        &dir.join("cache"),
-        &ReferenceRequest {
-            scene: &scene,
-            key: key.clone(),
-            strategy: ref_strategy,
-            spp: x.reference.spp,
-            seed: x.reference.seed,
-            threads: opts.threads,
-            relmse_epsilon: eps,
-            fresh: opts.fresh_reference,
-            progress: terminal,
-        },
-    )?;
-    let ri = &reference.info;
-    eprintln!(
-        "{}: reference {} at {} spp ({}, {:.1} s to render); noise floor MSE {:.3e}, relMSE {:.3e}",
-        exp.name,
-        ri.strategy,
-        ri.spp,
-        if reference.cached {
-            "cached"
-        } else {
-            "rendered now"
-        },
-        ri.seconds,
-        ri.mse_floor,
-        ri.relmse_floor
-    );
-
+    let (key, reference) = match (exp.cases[0].value, x.reference.spp) {
+        (Some(v), _) => {
+            let key = cache::constant_key(exp.scene(), exp.defines(), v, &base)?;
+            let r = cache::constant(scene.camera.width, scene.camera.height, v, key.clone());
+            (key, r)
+        }
+        (None, Some(spp)) => rendered_reference(&exp, opts, &scene, ref_strategy, spp, eps, &dir)?,
+        (None, None) => unreachable!("validated: a reference is rendered or given"),
+    };
     let mut h = Fnv::new();
     h.field(key.as_bytes()).field(&eps.to_le_bytes());
     let ctx = Ctx {

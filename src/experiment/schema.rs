@@ -3,7 +3,10 @@
 //!
 //! Unknown keys are errors (a misspelt `sps = [...]` must not silently fall back to a default).
 //! Paths are relative to the experiment file, so an experiment runs from any working directory.
+//! A file names one `scene`, or several `[[case]]`s (see `cases.rs`).
 
+use super::cases::{AccumulationSpec, Case, CaseSpec, ClosedForm, InvalidSpec, ProbeSpec};
+use super::validate::{cases, validate, validate_cases};
 use crate::cli::{HeuristicArg, LightSamplingArg, SelectionArg, StrategyArg, StrategyArgs};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -18,21 +21,28 @@ pub struct Experiment {
     /// Markdown paragraph put at the top of the report.
     #[serde(default)]
     pub description: String,
-    /// Scene file, relative to the experiment file.
-    pub scene: PathBuf,
-    /// `-D name=value` overrides of the scene's `<default>`s.
+    /// Scene file, relative to the experiment file (or `[[case]]` entries instead).
+    pub scene: Option<PathBuf>,
+    #[serde(rename = "case", default)]
+    pub cases: Vec<CaseSpec>,
+    /// `-D name=value` overrides of the scene's `<default>`s (of every case's scene).
     #[serde(default)]
     pub defines: BTreeMap<String, String>,
-    /// Samples per pixel of the sweep.
+    /// Samples per pixel of the sweep (in probe mode: the batch sizes).
     pub spp: Vec<u32>,
     /// Independent repetitions of every (strategy, spp); seeds are 0..seeds.
     #[serde(default = "default_seeds")]
     pub seeds: u32,
     #[serde(rename = "strategy")]
     pub strategies: Vec<StrategySpec>,
+    #[serde(default)]
     pub reference: ReferenceSpec,
     #[serde(default)]
     pub metrics: MetricsSpec,
+    pub probe: Option<ProbeSpec>,
+    #[serde(rename = "invalid", default)]
+    pub invalid: Vec<InvalidSpec>,
+    pub accumulation: Option<AccumulationSpec>,
     #[serde(default)]
     pub equal_time: Option<EqualTimeSpec>,
     #[serde(default)]
@@ -76,7 +86,12 @@ impl StrategySpec {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReferenceSpec {
-    pub spp: u32,
+    /// Samples per pixel of a rendered reference.
+    pub spp: Option<u32>,
+    /// A closed-form value instead: a constant reference image with no noise.
+    pub value: Option<f64>,
+    /// The formula that checks `value` (see `cases::ClosedForm`).
+    pub closed_form: Option<ClosedForm>,
     /// Estimator of the reference (CLI names); unset fields keep the scene's integrator.
     #[serde(default)]
     pub strategy: StrategyArgs,
@@ -88,6 +103,18 @@ pub struct ReferenceSpec {
 
 fn default_reference_seed() -> u64 {
     0x5EED_0000_0000
+}
+
+impl Default for ReferenceSpec {
+    fn default() -> Self {
+        ReferenceSpec {
+            spp: None,
+            value: None,
+            closed_form: None,
+            strategy: StrategyArgs::default(),
+            seed: default_reference_seed(),
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
@@ -165,6 +192,9 @@ pub struct FiguresSpec {
     pub crops: Vec<Crop>,
     /// Multiplies radiance before sRGB display (1 = as rendered).
     pub exposure: Option<f64>,
+    /// Probe mode: the cases drawn as panels of `convergence.png`.
+    #[serde(default)]
+    pub panels: Vec<String>,
 }
 
 /// What `--quick` replaces. Crops are fractional and need no override.
@@ -179,6 +209,8 @@ pub struct QuickSpec {
     pub equal_time_seconds: Option<Vec<f64>>,
     pub equal_spp: Option<u32>,
     pub progression: Option<Vec<u32>>,
+    pub probe_samples: Option<u32>,
+    pub accumulation_spp: Option<u32>,
 }
 
 /// An experiment ready to run: quick overrides applied, paths resolved, values checked.
@@ -186,13 +218,27 @@ pub struct QuickSpec {
 pub struct Resolved {
     pub name: String,
     pub file: PathBuf,
-    pub scene: PathBuf,
-    pub defines: Vec<(String, String)>,
     pub quick: bool,
     pub exp: Experiment,
+    /// At least one; exactly one unless in probe mode.
+    pub cases: Vec<Case>,
 }
 
 impl Resolved {
+    /// The scene of an image sweep (which has exactly one case).
+    pub fn scene(&self) -> &Path {
+        &self.cases[0].scene
+    }
+
+    pub fn defines(&self) -> &[(String, String)] {
+        &self.cases[0].defines
+    }
+
+    /// Resolves a path written in the experiment file.
+    pub fn path(&self, p: &Path) -> PathBuf {
+        self.file.parent().unwrap_or(Path::new(".")).join(p)
+    }
+
     pub fn equal_spp(&self) -> u32 {
         self.exp
             .figures
@@ -235,7 +281,7 @@ pub fn resolve(mut exp: Experiment, file: &Path, quick: bool) -> Result<Resolved
             exp.seeds = s;
         }
         if let Some(s) = q.reference_spp {
-            exp.reference.spp = s;
+            exp.reference.spp = Some(s);
         }
         if let (Some(t), Some(et)) = (q.equal_time_seconds, exp.equal_time.as_mut()) {
             et.seconds = t;
@@ -248,180 +294,27 @@ pub fn resolve(mut exp: Experiment, file: &Path, quick: bool) -> Result<Resolved
         if let Some(p) = q.progression {
             exp.figures.progression = p;
         }
+        if let (Some(n), Some(p)) = (q.probe_samples, exp.probe.as_mut()) {
+            p.samples = n;
+        }
+        if let (Some(n), Some(a)) = (q.accumulation_spp, exp.accumulation.as_mut()) {
+            a.spp = n;
+        }
         // Quick results live apart, so they never mix with (or resume into) the full run.
         name.push_str("-quick");
     }
     validate(&exp, file)?;
-    let scene = file.parent().unwrap_or(Path::new(".")).join(&exp.scene);
-    let defines = exp
-        .defines
-        .iter()
-        .map(|(k, v)| (k.clone(), v.clone()))
-        .collect();
+    let cases = cases(&exp, file)?;
+    validate_cases(&exp, &cases, file)?;
     Ok(Resolved {
         name,
         file: file.to_path_buf(),
-        scene,
-        defines,
         quick,
         exp,
+        cases,
     })
 }
 
-fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
-    let fail = |m: String| Err(format!("{}: {m}", file.display()));
-    if exp.spp.is_empty() || exp.spp.contains(&0) {
-        return fail("`spp` needs at least one value, all positive".into());
-    }
-    if exp.seeds == 0 {
-        return fail("`seeds` must be at least 1".into());
-    }
-    for (what, v) in [
-        ("figures.equal_spp", exp.figures.equal_spp),
-        ("figures.variance_spp", exp.figures.variance_spp),
-    ] {
-        if let Some(v) = v.filter(|v| !exp.spp.contains(v)) {
-            return fail(format!(
-                "{what} = {v} is not one of the sweep's spp {:?}",
-                exp.spp
-            ));
-        }
-    }
-    if exp.strategies.is_empty() {
-        return fail("at least one [[strategy]] is needed".into());
-    }
-    if exp.reference.spp < 2 {
-        return fail("reference.spp must be at least 2 (its noise is measured from it)".into());
-    }
-    if exp.reference.seed < exp.seeds as u64 {
-        return fail(format!(
-            "reference.seed {} is one of the sweep's seeds 0..{}; the reference must be independent",
-            exp.reference.seed, exp.seeds
-        ));
-    }
-    if !(exp.metrics.relmse_epsilon > 0.0) {
-        return fail("metrics.relmse_epsilon must be positive".into());
-    }
-    let mut names: Vec<&str> = exp.strategies.iter().map(|s| s.name.as_str()).collect();
-    names.sort();
-    if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
-        return fail(format!("strategy name '{}' is used twice", w[0]));
-    }
-    if let Some(et) = &exp.equal_time {
-        if et.seconds.iter().any(|s| !(*s > 0.0)) || et.seeds == 0 {
-            return fail("equal_time needs positive seconds and seeds >= 1".into());
-        }
-    }
-    for c in &exp.figures.crops {
-        let ok = c.x >= 0.0
-            && c.y >= 0.0
-            && c.width > 0.0
-            && c.height > 0.0
-            && c.x + c.width <= 1.0
-            && c.y + c.height <= 1.0;
-        if !ok {
-            return fail(format!(
-                "crop '{}' must lie inside the image (fractions in [0, 1])",
-                c.name
-            ));
-        }
-    }
-    Ok(())
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    const EXAMPLE: &str = r#"
-        title = "demo"
-        scene = "../scenes/cbox/cbox.xml"
-        defines = { res = "64" }
-        spp = [1, 4, 16]
-        seeds = 2
-        [reference]
-        spp = 256
-        strategy = { strategy = "mis", heuristic = "balance" }
-        [metrics]
-        relmse_epsilon = 0.001
-        [[strategy]]
-        name = "light"
-        strategy = "light"
-        emitter_selection = "power"
-        light_sampling = "solid-angle"
-        [[strategy]]
-        name = "one-sample"
-        strategy = "mis-onesample"
-        [equal_time]
-        seconds = [0.5]
-        [figures]
-        crops = [{ name = "corner", x = 0.0, y = 0.0, width = 0.25, height = 0.25 }]
-        [quick]
-        defines = { res = "16" }
-        spp = [1, 2]
-        reference_spp = 8
-    "#;
-
-    fn file() -> PathBuf {
-        PathBuf::from("experiments/demo.toml")
-    }
-
-    #[test]
-    fn parses_the_example_and_applies_quick() {
-        let exp = parse(EXAMPLE, &file()).unwrap();
-        assert_eq!(exp.strategies.len(), 2);
-        assert!(matches!(
-            exp.strategies[0].strategy,
-            Some(StrategyArg::Light)
-        ));
-        assert!(matches!(
-            exp.strategies[0].light_sampling,
-            Some(LightSamplingArg::SolidAngle)
-        ));
-        assert!(matches!(
-            exp.strategies[1].strategy,
-            Some(StrategyArg::MisOnesample)
-        ));
-        assert!(matches!(
-            exp.reference.strategy.heuristic,
-            Some(HeuristicArg::Balance)
-        ));
-        assert_eq!(exp.metrics.relmse_epsilon, 0.001);
-
-        let full = resolve(exp.clone(), &file(), false).unwrap();
-        assert_eq!(full.name, "demo");
-        assert_eq!(
-            full.scene,
-            PathBuf::from("experiments/../scenes/cbox/cbox.xml")
-        );
-        assert_eq!(full.defines, vec![("res".into(), "64".into())]);
-        assert_eq!(full.equal_spp(), 4);
-        assert_eq!(full.variance_spp(), 16);
-
-        let quick = resolve(exp, &file(), true).unwrap();
-        assert_eq!(quick.name, "demo-quick");
-        assert_eq!(quick.exp.spp, vec![1, 2]);
-        assert_eq!(quick.exp.reference.spp, 8);
-        assert_eq!(quick.defines, vec![("res".into(), "16".into())]);
-    }
-
-    #[test]
-    fn rejects_typos_and_bad_values() {
-        let typo = EXAMPLE.replace("seeds = 2", "sedes = 2");
-        assert!(parse(&typo, &file()).unwrap_err().contains("sedes"));
-        let bad_name = EXAMPLE.replace("\"solid-angle\"", "\"solid_angle\"");
-        assert!(parse(&bad_name, &file()).is_err());
-        let zero = EXAMPLE.replace("spp = [1, 4, 16]", "spp = [0, 4]");
-        let e = resolve(parse(&zero, &file()).unwrap(), &file(), false).unwrap_err();
-        assert!(e.contains("spp"), "{e}");
-        let shared_seed = EXAMPLE.replace("spp = 256", "spp = 256\nseed = 1");
-        let e = resolve(parse(&shared_seed, &file()).unwrap(), &file(), false).unwrap_err();
-        assert!(e.contains("independent"), "{e}");
-        let off = EXAMPLE.replace("[figures]", "[figures]\nequal_spp = 8");
-        let e = resolve(parse(&off, &file()).unwrap(), &file(), false).unwrap_err();
-        assert!(e.contains("equal_spp = 8 is not one of"), "{e}");
-        let crop = EXAMPLE.replace("width = 0.25", "width = 1.25");
-        let e = resolve(parse(&crop, &file()).unwrap(), &file(), false).unwrap_err();
-        assert!(e.contains("crop"), "{e}");
-    }
-}
+#[path = "schema_tests.rs"]
+mod tests;

@@ -2,6 +2,8 @@
 //! what was left out and why, tables, figures) and `reports/index.md` linking them all.
 
 mod means;
+pub mod probe;
+mod probe_table;
 mod tables;
 
 pub use means::{mean_check, mean_check_lines, Comparison, MEAN_ALPHA};
@@ -21,7 +23,7 @@ fn settings(md: &mut String, o: &Outcome) {
     let x = &o.exp.exp;
     let defines: Vec<String> = o
         .exp
-        .defines
+        .defines()
         .iter()
         .map(|(k, v)| format!("{k}={v}"))
         .collect();
@@ -29,7 +31,7 @@ fn settings(md: &mut String, o: &Outcome) {
     let _ = writeln!(
         md,
         "- Scene: `{}`{} ({}x{} pixels)",
-        o.exp.scene.display(),
+        o.exp.scene().display(),
         if defines.is_empty() {
             String::new()
         } else {
@@ -53,23 +55,32 @@ fn settings(md: &mut String, o: &Outcome) {
         x.metrics.relmse_epsilon
     );
     let ri = &o.reference.info;
-    let _ = writeln!(
-        md,
-        "- Reference: `{}` at {} spp, seed {}, {:.1} s to render ({}), {} non-finite samples; \
+    if let Some(v) = o.exp.cases[0].value {
+        let _ = writeln!(
+            md,
+            "- Reference: the constant {v:e} in every pixel and channel (a closed form, without \
+             noise: the noise floor below is 0); key `{}`.",
+            ri.key
+        );
+    } else {
+        let _ = writeln!(
+            md,
+            "- Reference: `{}` at {} spp, seed {}, {:.1} s to render ({}), {} non-finite samples; \
          cache key `{}`, renderer source hash `{}`.",
-        ri.strategy,
-        ri.spp,
-        ri.seed,
-        ri.seconds,
-        if o.reference.cached {
-            "from the cache"
-        } else {
-            "rendered in this run"
-        },
-        ri.non_finite_samples,
-        ri.key,
-        ri.renderer
-    );
+            ri.strategy,
+            ri.spp,
+            ri.seed,
+            ri.seconds,
+            if o.reference.cached {
+                "from the cache"
+            } else {
+                "rendered in this run"
+            },
+            ri.non_finite_samples,
+            ri.key,
+            ri.renderer
+        );
+    }
     let near = o.rows.iter().filter(|r| r.near_floor).count();
     let _ = writeln!(
         md,

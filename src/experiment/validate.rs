@@ -1,0 +1,240 @@
+//! Checks of an experiment file beyond its syntax, each naming the file and the key at fault,
+//! and the expansion of its `scene` or `[[case]]`s into runnable cases.
+
+use super::cases::{merge_defines, Case, CaseReferenceSpec, CaseSpec, MIN_BATCHES};
+use super::schema::Experiment;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The cases of a file: its `[[case]]`s, or its single `scene` as an unnamed case. A case's
+/// own defines win over the file's (which `--quick` has already updated).
+pub(super) fn cases(exp: &Experiment, file: &Path) -> Result<Vec<Case>, String> {
+    let dir = file.parent().unwrap_or(Path::new("."));
+    let single;
+    let specs: &[CaseSpec] = match (&exp.scene, exp.cases.is_empty()) {
+        (Some(scene), true) => {
+            single = [CaseSpec {
+                name: String::new(),
+                scene: scene.clone(),
+                defines: BTreeMap::new(),
+                reference: CaseReferenceSpec::default(),
+                group: String::new(),
+                about: String::new(),
+                warning: None,
+                blind: Vec::new(),
+            }];
+            &single
+        }
+        (None, false) => &exp.cases,
+        (Some(_), false) => {
+            return Err(format!(
+                "{}: give either `scene` or [[case]] entries, not both",
+                file.display()
+            ))
+        }
+        (None, true) => {
+            return Err(format!(
+                "{}: missing `scene` (or [[case]] entries)",
+                file.display()
+            ))
+        }
+    };
+    let v: Vec<Case> = specs
+        .iter()
+        .map(|c| Case {
+            name: c.name.clone(),
+            scene: dir.join(&c.scene),
+            defines: merge_defines(&[&exp.defines, &c.defines]),
+            value: c.reference.value.or(exp.reference.value),
+            closed_form: c.reference.closed_form.or(exp.reference.closed_form),
+            group: c.group.clone(),
+            about: c.about.clone(),
+            warning: c.warning.clone(),
+            blind: c.blind.clone(),
+        })
+        .collect();
+    Ok(v)
+}
+
+pub(super) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
+    let fail = |m: String| Err(format!("{}: {m}", file.display()));
+    if exp.spp.is_empty() || exp.spp.contains(&0) {
+        return fail("`spp` needs at least one value, all positive".into());
+    }
+    if exp.seeds == 0 {
+        return fail("`seeds` must be at least 1".into());
+    }
+    for (what, v) in [
+        ("figures.equal_spp", exp.figures.equal_spp),
+        ("figures.variance_spp", exp.figures.variance_spp),
+    ] {
+        if let Some(v) = v.filter(|v| !exp.spp.contains(v)) {
+            return fail(format!(
+                "{what} = {v} is not one of the sweep's spp {:?}",
+                exp.spp
+            ));
+        }
+    }
+    if exp.strategies.is_empty() {
+        return fail("at least one [[strategy]] is needed".into());
+    }
+    if exp.reference.spp.is_some_and(|s| s < 2) {
+        return fail("reference.spp must be at least 2 (its noise is measured from it)".into());
+    }
+    if exp.reference.spp.is_some() && exp.reference.seed < exp.seeds as u64 {
+        return fail(format!(
+            "reference.seed {} is one of the sweep's seeds 0..{}; the reference must be independent",
+            exp.reference.seed, exp.seeds
+        ));
+    }
+    // A closed-form reference may be 0, where relMSE then falls back to the MSE.
+    let eps = exp.metrics.relmse_epsilon;
+    if !(eps > 0.0 || (eps == 0.0 && exp.probe.is_some())) {
+        return fail("metrics.relmse_epsilon must be positive (0 is allowed in probe mode)".into());
+    }
+    let mut names: Vec<&str> = exp.strategies.iter().map(|s| s.name.as_str()).collect();
+    names.sort();
+    if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+        return fail(format!("strategy name '{}' is used twice", w[0]));
+    }
+    if let Some(et) = &exp.equal_time {
+        if et.seconds.iter().any(|s| !(*s > 0.0)) || et.seeds == 0 {
+            return fail("equal_time needs positive seconds and seeds >= 1".into());
+        }
+    }
+    for c in &exp.figures.crops {
+        let ok = c.x >= 0.0
+            && c.y >= 0.0
+            && c.width > 0.0
+            && c.height > 0.0
+            && c.x + c.width <= 1.0
+            && c.y + c.height <= 1.0;
+        if !ok {
+            return fail(format!(
+                "crop '{}' must lie inside the image (fractions in [0, 1])",
+                c.name
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks that depend on the mode: an image sweep has one scene and a rendered or constant
+/// reference; probe mode has named cases with closed-form values, and its own keys.
+pub(super) fn validate_cases(exp: &Experiment, cases: &[Case], file: &Path) -> Result<(), String> {
+    let fail = |m: String| Err(format!("{}: {m}", file.display()));
+    let r = &exp.reference;
+    let Some(p) = &exp.probe else {
+        if cases.len() > 1 {
+            return fail(
+                "several [[case]] entries need [probe]; an image sweep renders one scene per file"
+                    .into(),
+            );
+        }
+        let probe_only = [
+            ("[[invalid]]", !exp.invalid.is_empty()),
+            ("[accumulation]", exp.accumulation.is_some()),
+            ("figures.panels", !exp.figures.panels.is_empty()),
+            ("reference.closed_form", cases[0].closed_form.is_some()),
+        ];
+        if let Some((key, _)) = probe_only.iter().find(|(_, set)| *set) {
+            return fail(format!("{key} is only used in probe mode ([probe])"));
+        }
+        return match (r.spp, cases[0].value) {
+            (Some(_), Some(_)) => fail(
+                "give reference.spp (a rendered reference) or reference.value (a constant), not both"
+                    .into(),
+            ),
+            (None, None) => fail("[reference] needs spp (rendered) or value (a constant)".into()),
+            (_, Some(v)) if !v.is_finite() => fail(format!("reference.value {v} is not finite")),
+            _ => Ok(()),
+        };
+    };
+    if r.spp.is_some() {
+        return fail("reference.spp: probe mode measures against closed-form values only".into());
+    }
+    let image_only = [
+        ("[equal_time]", exp.equal_time.is_some()),
+        ("figures.equal_spp", exp.figures.equal_spp.is_some()),
+        ("figures.variance_spp", exp.figures.variance_spp.is_some()),
+        ("figures.progression", !exp.figures.progression.is_empty()),
+        ("figures.crops", !exp.figures.crops.is_empty()),
+        ("figures.exposure", exp.figures.exposure.is_some()),
+    ];
+    if let Some((key, _)) = image_only.iter().find(|(_, set)| *set) {
+        return fail(format!("{key} needs images; probe mode draws none"));
+    }
+    let mut seen = std::collections::BTreeSet::new();
+    for (i, c) in cases.iter().enumerate() {
+        if c.name.is_empty() {
+            return fail(format!("case[{i}].name: probe mode needs named [[case]]s"));
+        }
+        if !seen.insert(c.name.as_str()) {
+            return fail(format!("case[{i}].name '{}' is used twice", c.name));
+        }
+        match c.value {
+            None => {
+                return fail(format!(
+                "case '{}': reference.value is needed (probe mode measures against a closed form)",
+                c.name
+            ))
+            }
+            Some(v) if !v.is_finite() => {
+                return fail(format!(
+                    "case '{}': reference.value {v} is not finite",
+                    c.name
+                ))
+            }
+            _ => {}
+        }
+    }
+    let max = *exp.spp.iter().max().expect("validated non-empty");
+    if (p.samples / max) < MIN_BATCHES {
+        return fail(format!(
+            "probe.samples = {} leaves fewer than {MIN_BATCHES} batches at spp {max}",
+            p.samples
+        ));
+    }
+    if let Some(t) = p.table_spp.filter(|t| !exp.spp.contains(t)) {
+        return fail(format!(
+            "probe.table_spp = {t} is not one of the sweep's spp {:?}",
+            exp.spp
+        ));
+    }
+    if !(p.alpha > 0.0 && p.alpha < 1.0) {
+        return fail(format!("probe.alpha = {} must lie in (0, 1)", p.alpha));
+    }
+    let is_case = |n: &str| cases.iter().any(|c| c.name == n);
+    if let Some(n) = exp.figures.panels.iter().find(|n| !is_case(n)) {
+        return fail(format!("figures.panels: no [[case]] is named '{n}'"));
+    }
+    if let Some(a) = &exp.accumulation {
+        if !is_case(&a.case) {
+            return fail(format!(
+                "accumulation.case: no [[case]] is named '{}'",
+                a.case
+            ));
+        }
+        if let Some(n) = a
+            .strategies
+            .iter()
+            .find(|n| !exp.strategies.iter().any(|s| &s.name == *n))
+        {
+            return fail(format!(
+                "accumulation.strategies: no [[strategy]] is named '{n}'"
+            ));
+        }
+        if a.spp < 2 {
+            return fail("accumulation.spp must be at least 2".into());
+        }
+    }
+    for (i, v) in exp.invalid.iter().enumerate() {
+        if v.error.is_some() == v.warning.is_some() {
+            return fail(format!(
+                "invalid[{i}] ({}): give exactly one of `error` and `warning`",
+                v.scene.display()
+            ));
+        }
+    }
+    Ok(())
+}
