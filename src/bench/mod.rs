@@ -17,7 +17,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Scenes to measure (default: the bundled Cornell box).
+    /// Scenes to measure (default: the bundled Cornell box and Veach MIS scene).
     #[arg(long = "scene")]
     pub scenes: Vec<PathBuf>,
     /// Thread counts to measure.
@@ -142,7 +142,10 @@ fn peak_memory() -> Option<u64> {
 
 pub fn run(a: &BenchArgs) -> Result<(), String> {
     let scenes = if a.scenes.is_empty() {
-        vec![PathBuf::from("scenes/cbox/cbox.xml")]
+        vec![
+            PathBuf::from("scenes/cbox/cbox.xml"),
+            PathBuf::from("scenes/veach-mis/veach-mis.xml"),
+        ]
     } else {
         a.scenes.clone()
     };
