@@ -7,6 +7,7 @@
 //! samples). For the bundled all-diffuse scenes that is the renderer's ray distribution.
 
 use crate::emitter::LightSampling;
+use crate::geometry::shape::intersect_sphere;
 use crate::geometry::{Hit, Ray, ShapeKind};
 use crate::math::Frame;
 use crate::rng::Rng;
@@ -91,33 +92,48 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
     }
 }
 
-/// The same mix through obvhs's own CwBvh traversal and triangle test over the scene's
-/// triangles (spheres left out; the bench scenes have none): what the library gives without
-/// directlab's traversal. Not a renderer: its test is not watertight and it culls hits closer
-/// than t = 1e-4.
+/// The same mix through obvhs's own CwBvh traversal and triangle test (spheres use
+/// directlab's sphere test): what the library gives without directlab's traversal. Not a
+/// renderer: its triangle test is not watertight and it culls hits closer than t = 1e-4.
 pub fn measure_obvhs(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
-    use obvhs::{cwbvh::builder::build_cwbvh_from_tris, triangle::Triangle, BvhBuildParams};
-    let tris: Vec<Triangle> = scene
-        .shapes
-        .iter()
-        .filter_map(|s| match &s.kind {
-            ShapeKind::Mesh(m) => Some(m),
-            ShapeKind::Sphere(_) => None,
-        })
-        .flat_map(|m| {
-            (0..m.indices.len()).map(|t| {
+    use obvhs::{aabb::Aabb, cwbvh::builder::build_cwbvh, triangle::Triangle, BvhBuildParams};
+    enum Prim {
+        Tri(Triangle),
+        Sphere(glam::Vec3, f32),
+    }
+    let mut prims = Vec::new();
+    for s in &scene.shapes {
+        match &s.kind {
+            ShapeKind::Mesh(m) => prims.extend((0..m.indices.len()).map(|t| {
                 let [v0, v1, v2] = m.vertices(t).map(Into::into);
-                Triangle { v0, v1, v2 }
-            })
+                Prim::Tri(Triangle { v0, v1, v2 })
+            })),
+            ShapeKind::Sphere(s) => prims.push(Prim::Sphere(s.center, s.radius)),
+        }
+    }
+    let aabbs: Vec<Aabb> = prims
+        .iter()
+        .map(|p| match p {
+            Prim::Tri(t) => Aabb::from_points(&[t.v0, t.v1, t.v2]),
+            Prim::Sphere(c, r) => {
+                let (c, r) = (glam::Vec3A::from(*c), glam::Vec3A::splat(*r));
+                Aabb::new(c - r, c + r)
+            }
         })
         .collect();
-    let bvh = build_cwbvh_from_tris(
-        &tris,
+    let bvh = build_cwbvh(
+        &aabbs,
         BvhBuildParams::medium_build(),
         &mut std::time::Duration::default(),
     );
     let ray = |r: &Ray| obvhs::ray::Ray::new(r.o.into(), r.d.into(), r.tmin, r.tmax);
-    let prim = |r: &obvhs::ray::Ray, i: usize| tris[bvh.primitive_indices[i] as usize].intersect(r);
+    let prim = |r: &obvhs::ray::Ray, i: usize| match &prims[bvh.primitive_indices[i] as usize] {
+        Prim::Tri(t) => t.intersect(r),
+        Prim::Sphere(c, rad) => {
+            let (o, d) = (r.origin.into(), r.direction.into());
+            intersect_sphere(o, d, r.tmin, r.tmax, *c, *rad).unwrap_or(f32::INFINITY)
+        }
+    };
     let mut best = (f64::INFINITY, f64::INFINITY);
     let mut sink = 0usize;
     for _ in 0..repeat.max(1) {
