@@ -5,7 +5,7 @@
 //! with splatting, but every pixel is the plain mean of its own independent samples, so
 //! per-pixel variance and error are meaningful for the harness.
 
-use crate::geometry::Ray;
+use crate::geometry::{Ray, NO_SKIP};
 use crate::rng::Rng;
 use crate::scene::desc::{CameraDesc, FilmDesc, FilterDesc, FovAxis};
 use glam::{Mat4, Vec2, Vec3};
@@ -96,6 +96,7 @@ impl Camera {
             d: d / len,
             tmin: self.near * len,
             tmax: self.far * len,
+            skip: NO_SKIP,
         }
     }
 }

@@ -45,11 +45,11 @@ pub fn ray_mix(scene: &Scene, spp: u32) -> RayMix {
                 if let Some(ls) =
                     scene.emitters[e].sample(&scene.shapes, sp.p, u_prim, u, LightSampling::Area)
                 {
-                    mix.shadow.push(Scene::shadow_ray(&sp, &ls));
+                    mix.shadow.push(scene.shadow_ray(&sp, &ls));
                 }
                 let d =
                     Frame::from_normal(sp.ns).to_world(square_to_cosine_hemisphere(rng.next_2d()));
-                mix.bsdf.push(Ray::new(sp.spawn_origin(d), d));
+                mix.bsdf.push(scene.spawn_ray(&sp, d));
             }
         }
     }

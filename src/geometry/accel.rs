@@ -4,8 +4,8 @@
 use super::bvh::WideBvh;
 use super::shape::{intersect_sphere, Shape, ShapeKind};
 use super::watertight::{Tri4, WatertightRay};
-use super::{Hit, Ray};
-use glam::{Vec2, Vec3, Vec3A};
+use super::{Hit, Ray, SurfacePoint, NO_SKIP};
+use glam::{BVec4A, Vec2, Vec3, Vec3A};
 use obvhs::{aabb::Aabb, bvh2::builder::build_bvh2, BvhBuildParams};
 use std::time::Duration;
 
@@ -23,13 +23,27 @@ struct Leaf {
     spheres: (u32, u32),
 }
 
+impl Leaf {
+    /// The lanes holding triangle `id`.
+    #[inline(always)]
+    fn skip(&self, id: u32) -> BVec4A {
+        let r = &self.tri_ref;
+        BVec4A::new(r[0] == id, r[1] == id, r[2] == id, r[3] == id)
+    }
+}
+
 pub struct Accel {
     bvh: WideBvh,
     leaves: Vec<Leaf>,
     /// (centre, radius, index in `refs`).
     spheres: Vec<(Vec3, f32, u32)>,
-    /// (shape index, triangle index within the shape) per primitive.
+    /// (shape index, triangle index within the shape) per primitive id.
     refs: Vec<(u32, u32)>,
+    /// Per shape, the id of its first triangle (ids of a mesh's triangles are consecutive,
+    /// so a surface point names its triangle's id), or `NO_SKIP` for a sphere.
+    tri_base: Vec<u32>,
+    /// Primitives in the BVH (zero-area triangles have an id but are left out).
+    n_prims: usize,
 }
 
 /// A primitive before it is placed in a leaf.
@@ -41,24 +55,28 @@ enum Prim {
 impl Accel {
     /// Builds over all shapes; zero-area triangles are left out since no ray can hit them.
     pub fn build(shapes: &[Shape]) -> Accel {
+        // (primitive, its id in `refs`)
         let mut prims = Vec::new();
         let mut refs = Vec::new();
+        let mut tri_base = Vec::new();
         let mut aabbs = Vec::new();
         for (si, shape) in shapes.iter().enumerate() {
             match &shape.kind {
                 ShapeKind::Mesh(m) => {
+                    tri_base.push(refs.len() as u32);
                     for ti in 0..m.indices.len() {
+                        refs.push((si as u32, ti as u32));
                         let [a, b, c] = m.vertices(ti);
                         if (b - a).cross(c - a).length_squared() == 0.0 {
                             continue;
                         }
-                        prims.push(Prim::Tri([a, b, c]));
-                        refs.push((si as u32, ti as u32));
+                        prims.push((Prim::Tri([a, b, c]), refs.len() as u32 - 1));
                         aabbs.push(Aabb::from_points(&[a, b, c].map(Vec3A::from)));
                     }
                 }
                 ShapeKind::Sphere(s) => {
-                    prims.push(Prim::Sphere(s.center, s.radius));
+                    tri_base.push(NO_SKIP);
+                    prims.push((Prim::Sphere(s.center, s.radius), refs.len() as u32));
                     refs.push((si as u32, 0));
                     let (c, r): (Vec3A, _) = (s.center.into(), Vec3A::splat(s.radius));
                     aabbs.push(Aabb::new(c - r, c + r));
@@ -70,6 +88,8 @@ impl Accel {
             leaves: Vec::new(),
             spheres: Vec::new(),
             refs,
+            tri_base,
+            n_prims: prims.len(),
         };
         if prims.is_empty() {
             return accel;
@@ -96,11 +116,11 @@ impl Accel {
             let s0 = accel.spheres.len() as u32;
             for &id in ids {
                 match prims[id as usize] {
-                    Prim::Tri(v) => {
-                        tri_ref[tris.len()] = id;
+                    (Prim::Tri(v), rid) => {
+                        tri_ref[tris.len()] = rid;
                         tris.push(v);
                     }
-                    Prim::Sphere(c, r) => accel.spheres.push((c, r, id)),
+                    (Prim::Sphere(c, r), rid) => accel.spheres.push((c, r, rid)),
                 }
             }
             let n_tris = tris.len() as u32;
@@ -121,7 +141,17 @@ impl Accel {
     }
 
     pub fn primitive_count(&self) -> usize {
-        self.refs.len()
+        self.n_prims
+    }
+
+    /// `Ray::skip` for a ray leaving `sp`, or ending on it: its triangle, which is flat, so no
+    /// such ray meets it again; a sphere can be met again (from inside), so nothing is skipped.
+    #[inline]
+    pub fn skip_id(&self, sp: &SurfacePoint) -> u32 {
+        match self.tri_base[sp.shape as usize] {
+            NO_SKIP => NO_SKIP,
+            base => base + sp.prim,
+        }
     }
 
     /// Closest hit within the ray's interval.
@@ -152,7 +182,8 @@ impl Accel {
             |l, mut tmax| {
                 let leaf = &self.leaves[l];
                 if leaf.n_tris > 0 {
-                    if let Some((lane, t, b1, b2)) = wr.closest(&leaf.tris, tmin, tmax) {
+                    let skip = leaf.skip(ray.skip);
+                    if let Some((lane, t, b1, b2)) = wr.closest(&leaf.tris, tmin, tmax, skip) {
                         tmax = t;
                         best = (leaf.tri_ref[lane], Vec2::new(b1, b2));
                     }
@@ -189,7 +220,7 @@ impl Accel {
             #[inline(always)]
             |l, tmax| {
                 let leaf = &self.leaves[l];
-                (leaf.n_tris > 0 && wr.any(&leaf.tris, tmin, tmax))
+                (leaf.n_tris > 0 && wr.any(&leaf.tris, tmin, tmax, leaf.skip(ray.skip)))
                     || self.spheres[leaf.spheres.0 as usize..leaf.spheres.1 as usize]
                         .iter()
                         .any(|&(c, r, _)| intersect_sphere(o, d, tmin, tmax, c, r).is_some())
@@ -277,6 +308,40 @@ mod tests {
             hits > 500,
             "only {hits} hits: the test exercises too few hits"
         );
+    }
+
+    /// A ray told to skip the triangle it would hit passes through to the one behind: the id
+    /// a surface point gives names its own triangle, also after a zero-area triangle (which
+    /// has an id but no place in the BVH).
+    #[test]
+    fn skipped_triangle_is_passed_through() {
+        let mut front = quad_grid(4, 0.5);
+        if let ShapeKind::Mesh(m) = &mut front.kind {
+            let mut indices = vec![[0, 0, 1]];
+            indices.extend_from_slice(&m.indices);
+            *m = Mesh::new(m.positions.clone(), None, indices);
+        }
+        let shapes = vec![quad_grid(4, 0.0), front];
+        let accel = Accel::build(&shapes);
+        let mut rng = Rng::new(3, 3);
+        let mut through = 0;
+        for _ in 0..500 {
+            let o = Vec3::new(rng.next_f32(), rng.next_f32(), 2.0);
+            let mut ray = Ray::new(o, -Vec3::Z);
+            let front_hit = accel.intersect(&ray, &shapes).unwrap();
+            assert_eq!(front_hit.sp.shape, 1);
+            ray.skip = accel.skip_id(&front_hit.sp);
+            let back_hit = accel.intersect(&ray, &shapes).unwrap();
+            // Through an edge the ray still meets the neighbouring front triangle.
+            if back_hit.sp.shape == 0 {
+                assert!((back_hit.t - 2.0).abs() < 1e-5);
+                through += 1;
+            } else {
+                assert_ne!(back_hit.sp.prim, front_hit.sp.prim);
+            }
+            assert!(accel.occluded(&ray));
+        }
+        assert!(through > 490, "{through} of 500 rays passed through");
     }
 
     #[test]

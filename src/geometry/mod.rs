@@ -18,7 +18,14 @@ pub struct Ray {
     pub d: Vec3,
     pub tmin: f32,
     pub tmax: f32,
+    /// Accelerator id of a flat triangle the ray cannot hit inside its interval (the one it
+    /// leaves, or the one a shadow ray ends on), or `NO_SKIP`. Skipping it spares the f64
+    /// re-check of a hit at t = 0 that the f32 error bound cannot place (see `watertight`).
+    pub skip: u32,
 }
+
+/// `Ray::skip` of a ray that may hit every primitive.
+pub const NO_SKIP: u32 = u32::MAX;
 
 impl Ray {
     pub fn new(o: Vec3, d: Vec3) -> Self {
@@ -27,6 +34,7 @@ impl Ray {
             d,
             tmin: 0.0,
             tmax: f32::INFINITY,
+            skip: NO_SKIP,
         }
     }
 }

@@ -184,7 +184,7 @@ impl<'a> Direct<'a> {
             return Rgb::ZERO;
         };
         let d = sh.frame.to_world(bs.wo);
-        let ray = Ray::new(sh.sp.spawn_origin(d), d);
+        let ray = scene.spawn_ray(&sh.sp, d);
         let Some(hit) = scene.intersect_emitter(&ray) else {
             return Rgb::ZERO;
         };

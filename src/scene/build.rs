@@ -297,12 +297,21 @@ impl Scene {
     /// receiver nor the light itself counts as a blocker.
     #[inline]
     pub fn visible(&self, from: &SurfacePoint, ls: &LightSample) -> bool {
-        !self.accel.occluded(&Self::shadow_ray(from, ls))
+        !self.accel.occluded(&self.shadow_ray(from, ls))
+    }
+
+    /// A ray leaving `sp` in direction `d`.
+    #[inline]
+    pub fn spawn_ray(&self, sp: &SurfacePoint, d: glam::Vec3) -> Ray {
+        Ray {
+            skip: self.accel.skip_id(sp),
+            ..Ray::new(sp.spawn_origin(d), d)
+        }
     }
 
     /// The shadow ray `visible` traces (unnormalised direction, t in [0, 1 - 1e-4]).
     #[inline]
-    pub fn shadow_ray(from: &SurfacePoint, ls: &LightSample) -> Ray {
+    pub fn shadow_ray(&self, from: &SurfacePoint, ls: &LightSample) -> Ray {
         let o = from.spawn_origin(ls.p - from.p);
         let target = if ls.delta {
             ls.p
@@ -314,6 +323,7 @@ impl Scene {
             d: target - o,
             tmin: 0.0,
             tmax: 1.0 - 1e-4,
+            skip: self.accel.skip_id(from),
         }
     }
 

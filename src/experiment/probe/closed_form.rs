@@ -30,12 +30,7 @@ fn receiver(scene: &Scene) -> Result<Receiver, String> {
     let m = scene.desc.camera.to_world;
     let (o, d) = (m.transform_point3(Vec3::ZERO), m.transform_vector3(Vec3::Z));
     let hit = scene
-        .intersect(&Ray {
-            o,
-            d: d.normalize(),
-            tmin: 0.0,
-            tmax: f32::INFINITY,
-        })
+        .intersect(&Ray::new(o, d.normalize()))
         .ok_or("the camera's axis meets no surface")?;
     let shape = hit.sp.shape as usize;
     let ShapeGeometry::Mesh {
@@ -119,12 +114,7 @@ pub fn evaluate(scene: &Scene, form: ClosedForm) -> Result<f64, String> {
 fn mirror_radiance(scene: &Scene, r: &Receiver, wo: Vec3) -> Result<f64, String> {
     let wi = 2.0 * wo.dot(r.n) * r.n - wo;
     let hit = scene
-        .intersect(&Ray {
-            o: r.x + r.n * 1e-4 * r.eye.distance(r.x),
-            d: wi,
-            tmin: 0.0,
-            tmax: f32::INFINITY,
-        })
+        .intersect(&Ray::new(r.x + r.n * 1e-4 * r.eye.distance(r.x), wi))
         .ok_or("the mirror direction meets no surface")?;
     let e = scene.desc.shapes[hit.sp.shape as usize]
         .emitter
