@@ -65,6 +65,18 @@ pub struct RayLimit {
 }
 
 /// Times the mix on one thread, best of `repeat`.
+impl RayLimit {
+    /// Rates from the best (closest-hit, occlusion) seconds for the whole mix.
+    fn from_seconds(mix: &RayMix, best: (f64, f64)) -> RayLimit {
+        let n_closest = (mix.camera.len() + mix.bsdf.len()) as f64;
+        RayLimit {
+            closest_per_s: n_closest / best.0,
+            occlusion_per_s: mix.shadow.len() as f64 / best.1,
+            seconds_per_sample: (best.0 + best.1) / mix.camera.len() as f64,
+        }
+    }
+}
+
 pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
     let mut best = (f64::INFINITY, f64::INFINITY);
     let mut sink = 0usize;
@@ -84,12 +96,7 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
         best = (best.0.min(closest), best.1.min(occl));
     }
     std::hint::black_box(sink);
-    let n_closest = (mix.camera.len() + mix.bsdf.len()) as f64;
-    RayLimit {
-        closest_per_s: n_closest / best.0,
-        occlusion_per_s: mix.shadow.len() as f64 / best.1,
-        seconds_per_sample: (best.0 + best.1) / mix.camera.len() as f64,
-    }
+    RayLimit::from_seconds(mix, best)
 }
 
 /// The same mix through obvhs's own CwBvh traversal and triangle test (spheres use
@@ -151,10 +158,5 @@ pub fn measure_obvhs(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
         best = (best.0.min(closest), best.1.min(occl));
     }
     std::hint::black_box(sink);
-    let n_closest = (mix.camera.len() + mix.bsdf.len()) as f64;
-    RayLimit {
-        closest_per_s: n_closest / best.0,
-        occlusion_per_s: mix.shadow.len() as f64 / best.1,
-        seconds_per_sample: (best.0 + best.1) / mix.camera.len() as f64,
-    }
+    RayLimit::from_seconds(mix, best)
 }
