@@ -64,7 +64,6 @@ pub struct RayLimit {
     pub seconds_per_sample: f64,
 }
 
-/// Times the mix on one thread, best of `repeat`.
 impl RayLimit {
     /// Rates from the best (closest-hit, occlusion) seconds for the whole mix.
     fn from_seconds(mix: &RayMix, best: (f64, f64)) -> RayLimit {
@@ -77,6 +76,7 @@ impl RayLimit {
     }
 }
 
+/// Times the mix on one thread, best of `repeat`.
 pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
     let mut best = (f64::INFINITY, f64::INFINITY);
     let mut sink = 0usize;
