@@ -15,6 +15,15 @@ fn scratch(name: &str) -> PathBuf {
     d
 }
 
+/// `directlab run EXP --out OUT`, which must succeed.
+fn run_ok(exp: &Path, out: &Path) {
+    let o = Command::new(env!("CARGO_BIN_EXE_directlab"))
+        .args(["run", exp.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 fn run_quick(exp: &str, out: &Path) -> Output {
     let o = Command::new(env!("CARGO_BIN_EXE_directlab"))
         .args([
@@ -140,11 +149,7 @@ emitter_selection = "power"
         ),
     )
     .unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_directlab"))
-        .args(["run", exp.to_str().unwrap(), "--out", out.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&exp, &out);
     let index = std::fs::read_to_string(out.join("one-light/index.md")).unwrap();
     assert!(
         index.contains("**power** (`light-e1-pow-area`): identical to 'uniform'"),
@@ -205,11 +210,7 @@ strategy = "bsdf"
 "#,
     )
     .unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_directlab"))
-        .args(["run", exp.to_str().unwrap(), "--out", out.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&exp, &out);
     let index = std::fs::read_to_string(out.join("furnace/index.md")).unwrap();
     assert!(
         index.contains("the constant 1.5e0 in every pixel"),
