@@ -93,7 +93,7 @@ impl Camera {
         // they are near*|d| and far*|d| along the unit world ray.
         Ray {
             o: self.origin,
-            d: d / len,
+            d: crate::math::div3(d, len),
             tmin: self.near * len,
             tmax: self.far * len,
             skip: NO_SKIP,

@@ -1,6 +1,6 @@
 //! Small geometric helpers shared by every module.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 pub use crate::scene::desc::Rgb;
 
@@ -19,6 +19,13 @@ pub struct Frame {
     pub s: Vec3,
     pub t: Vec3,
     pub n: Vec3,
+}
+
+/// `v / s`, all three quotients in one SIMD division (each correctly rounded, so bitwise the
+/// same as three scalar ones, at a third of the latency-bound cost).
+#[inline(always)]
+pub fn div3(v: Vec3, s: f32) -> Vec3 {
+    (Vec3A::from(v) / s).into()
 }
 
 impl Frame {

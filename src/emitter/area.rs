@@ -30,7 +30,7 @@ fn facing(ref_p: Vec3, sp: &SurfacePoint) -> Option<(Vec3, f32)> {
     if !(dist > 0.0) {
         return None;
     }
-    let wi = d / dist;
+    let wi = crate::math::div3(d, dist);
     (sp.ns.dot(-wi) > 0.0).then_some((wi, dist))
 }
 
@@ -62,22 +62,30 @@ impl AreaLight {
     /// Uniform-by-area density converted to solid angle: p_w = d^2 / (A |cos theta_light|).
     #[inline]
     fn area_pdf(&self, ref_p: Vec3, sp: &SurfacePoint) -> f32 {
-        match facing(ref_p, sp) {
-            Some((wi, dist)) => {
-                let cos_l = sp.ng.dot(wi).abs();
-                if cos_l > 0.0 {
-                    dist * dist / (self.area * cos_l)
-                } else {
-                    0.0
-                }
-            }
-            None => 0.0,
+        facing(ref_p, sp).map_or(0.0, |(wi, dist)| self.area_pdf_along(sp, wi, dist))
+    }
+
+    /// `area_pdf` for a light point already known to face the reference point along `wi`.
+    #[inline]
+    fn area_pdf_along(&self, sp: &SurfacePoint, wi: Vec3, dist: f32) -> f32 {
+        let cos_l = sp.ng.dot(wi).abs();
+        if cos_l > 0.0 {
+            dist * dist / (self.area * cos_l)
+        } else {
+            0.0
         }
     }
 
+    /// The sample at light point `sp`, if it faces `ref_p`; `pdf(wi, dist)` gives its density.
     #[inline]
-    fn make_sample(&self, ref_p: Vec3, sp: &SurfacePoint, pdf: f32) -> Option<LightSample> {
+    fn make_sample(
+        &self,
+        ref_p: Vec3,
+        sp: &SurfacePoint,
+        pdf: impl FnOnce(Vec3, f32) -> f32,
+    ) -> Option<LightSample> {
         let (wi, dist) = facing(ref_p, sp)?;
+        let pdf = pdf(wi, dist);
         (pdf > 0.0 && pdf.is_finite()).then_some(LightSample {
             p: sp.p,
             ng: sp.ng,
@@ -111,7 +119,7 @@ impl AreaLight {
                     let b = to_c.dot(wi);
                     let disc = (s.radius * s.radius - (to_c - b * wi).length_squared()).max(0.0);
                     let sp = s.surface_point(ref_p + wi * (b - disc.sqrt()), self.shape);
-                    return self.make_sample(ref_p, &sp, 1.0 / (2.0 * PI * one_minus));
+                    return self.make_sample(ref_p, &sp, |_, _| 1.0 / (2.0 * PI * one_minus));
                 }
                 s.surface_point(
                     s.center + square_to_uniform_sphere(u) * s.radius,
@@ -126,13 +134,13 @@ impl AreaLight {
                     if let Some((w, pdf)) = sample_spherical_triangle(ref_p, v, u) {
                         let sp =
                             m.surface_point(tri, ray_plane_barycentrics(ref_p, w, v)?, self.shape);
-                        return self.make_sample(ref_p, &sp, table.pmf(tri) * pdf);
+                        return self.make_sample(ref_p, &sp, |_, _| table.pmf(tri) * pdf);
                     }
                 }
                 m.surface_point(tri, square_to_uniform_triangle(u), self.shape)
             }
         };
-        self.make_sample(ref_p, &sp, self.area_pdf(ref_p, &sp))
+        self.make_sample(ref_p, &sp, |wi, dist| self.area_pdf_along(&sp, wi, dist))
     }
 
     /// The density `sample` has for the light point `sp`; it must make the same choices

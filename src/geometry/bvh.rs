@@ -54,7 +54,7 @@ impl BoxRay {
     fn new(o: Vec3, d: Vec3, tmin: f32) -> Self {
         // 1/0 = inf would meet a zero (b - o) and give NaN; f32::MAX keeps every product
         // ordered (0 stays 0, anything else overflows to the right infinity).
-        let inv = Vec3::ONE / d;
+        let inv = Vec3::from(glam::Vec3A::ONE / glam::Vec3A::from(d));
         let inv = inv.clamp(Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX));
         let neg = |x: f32| x.is_sign_negative() as usize;
         let near = [neg(inv.x), 2 + neg(inv.y), 4 + neg(inv.z)];
@@ -69,10 +69,11 @@ impl BoxRay {
 
     /// Entry distances of the four children and the mask of those entered before `tmax`.
     #[inline(always)]
-    fn test(&self, n: &Node, tmax: f32) -> (u32, [Vec4; H]) {
+    fn test(&self, n: &Node, tmax: f32) -> (u32, [f32; W]) {
         let mut mask = 0;
-        let mut tns = [Vec4::ZERO; H];
-        for (h, tn_out) in tns.iter_mut().enumerate() {
+        // A flat array: indexing a Vec4 by a runtime lane compiles to a branch chain.
+        let mut tns = [0.0; W];
+        for (h, tn_out) in tns.chunks_exact_mut(4).enumerate() {
             let t = |i: usize, a: usize| (n.b[i][h] - self.o[a]) * self.inv[a];
             let tn = t(self.near[0], 0)
                 .max(t(self.near[1], 1))
@@ -83,7 +84,7 @@ impl BoxRay {
                 .min(t(self.far[2], 2))
                 .min(Vec4::splat(tmax));
             mask |= tn.cmple(tf * ROBUST).bitmask() << (4 * h);
-            *tn_out = tn;
+            tn.write_to_slice(tn_out);
         }
         (mask, tns)
     }
@@ -243,7 +244,7 @@ impl WideBvh {
                     while mask != 0 {
                         let lane = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
-                        let entry = (n.child[lane], tn[lane / 4][lane % 4]);
+                        let entry = (n.child[lane], tn[lane]);
                         let mut k = sp;
                         while k > base && stack[k - 1].1 < entry.1 {
                             stack[k] = stack[k - 1];

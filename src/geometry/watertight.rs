@@ -78,14 +78,18 @@ impl WatertightRay {
             2
         };
         let axes = AXES[kz as usize];
-        let dp = Vec3::new(d[axes[0]], d[axes[1]], d[axes[2]]);
+        // Arrays, not glam's Index: a runtime index into a Vec3 compiles to a branch chain.
+        let (oa, da) = (o.to_array(), d.to_array());
+        let dp = Vec3::new(da[axes[0]], da[axes[1]], da[axes[2]]);
         WatertightRay {
             o: o.into(),
             d: d.into(),
             kz,
             axes,
-            o4: axes.map(|i| Vec4::splat(o[i])),
-            shear: [-dp.x / dp.z, -dp.y / dp.z, 1.0 / dp.z].map(Vec4::splat),
+            o4: axes.map(|i| Vec4::splat(oa[i])),
+            shear: crate::math::div3(Vec3::new(-dp.x, -dp.y, 1.0), dp.z)
+                .to_array()
+                .map(Vec4::splat),
         }
     }
 
@@ -94,6 +98,7 @@ impl WatertightRay {
     #[inline(always)]
     pub fn closest(&self, tri: &Tri4, tmin: f32, tmax: f32, skip: BVec4A) -> Option<LaneHit> {
         let (mut hit, t, b1, b2) = self.lanes(tri, tmin, tmax, skip)?;
+        let (t, b1, b2) = (t.to_array(), b1.to_array(), b2.to_array());
         let mut best: Option<LaneHit> = None;
         while hit != 0 {
             let lane = hit.trailing_zeros() as usize;
