@@ -1,5 +1,5 @@
 //! An 8-wide BVH collapsed from obvhs's binary BVH (PLOC build plus reinsertion) and traversed
-//! with two 4-lane box tests per node. (8 children beat 4 by 5-8 % on cbox and veach-mis
+//! with one 8-lane box test per node (see `lanes8`). (8 children beat 4 by 5-8 % on cbox and veach-mis
 //! rays: fewer nodes on the way down, fewer unpredictable branches.)
 //!
 //! Why not obvhs's own CwBvh traversal: its 8-bit quantised child boxes cost a decode per node,
@@ -8,7 +8,8 @@
 //! the slab test is made conservative with pbrt-v4's (1 + 2 gamma(3)) factor so that a ray
 //! through the shared edge of two triangles in different leaves enters both leaves.
 
-use glam::{Vec3, Vec4};
+use super::lanes8::F8;
+use glam::Vec3;
 use obvhs::{aabb::Aabb, bvh2::Bvh2};
 
 /// Child slot tags: a leaf is `LEAF | leaf index`, an internal child is its node index, an
@@ -19,15 +20,14 @@ const EMPTY: u32 = u32::MAX;
 const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 /// Stack entries the traversal keeps on its own stack; deeper trees use a heap stack.
 const STACK: usize = 64;
-/// Children per node, tested as W / 4 groups of four lanes.
+/// Children per node, tested together.
 const W: usize = 8;
-const H: usize = W / 4;
 
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(16))]
+#[repr(C, align(32))]
 struct Node {
-    /// Per child lane: min x, max x, min y, max y, min z, max z.
-    b: [[Vec4; H]; 6],
+    /// Per plane (min x, max x, min y, max y, min z, max z), its coordinate for each child.
+    b: [[f32; W]; 6],
     child: [u32; W],
 }
 
@@ -41,12 +41,12 @@ pub struct WideBvh {
 
 /// Per-ray data of the box test.
 struct BoxRay {
-    o: [Vec4; 3],
-    inv: [Vec4; 3],
+    o: [F8; 3],
+    inv: [F8; 3],
     /// Index into `Node::b` of each axis's near and far plane (by the direction's sign).
     near: [usize; 3],
     far: [usize; 3],
-    tmin: Vec4,
+    tmin: F8,
 }
 
 impl BoxRay {
@@ -59,34 +59,29 @@ impl BoxRay {
         let neg = |x: f32| x.is_sign_negative() as usize;
         let near = [neg(inv.x), 2 + neg(inv.y), 4 + neg(inv.z)];
         BoxRay {
-            o: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
-            inv: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            o: [F8::splat(o.x), F8::splat(o.y), F8::splat(o.z)],
+            inv: [F8::splat(inv.x), F8::splat(inv.y), F8::splat(inv.z)],
             near,
             far: near.map(|i| i ^ 1),
-            tmin: Vec4::splat(tmin),
+            tmin: F8::splat(tmin),
         }
     }
 
-    /// Entry distances of the four children and the mask of those entered before `tmax`.
+    /// Entry distances of the children and the mask of those entered before `tmax`.
     #[inline(always)]
     fn test(&self, n: &Node, tmax: f32) -> (u32, [f32; W]) {
-        let mut mask = 0;
-        // A flat array: indexing a Vec4 by a runtime lane compiles to a branch chain.
+        let t = |i: usize, a: usize| F8::load(&n.b[i]).sub(self.o[a]).mul(self.inv[a]);
+        let tn = t(self.near[0], 0)
+            .max(t(self.near[1], 1))
+            .max(t(self.near[2], 2))
+            .max(self.tmin);
+        let tf = t(self.far[0], 0)
+            .min(t(self.far[1], 1))
+            .min(t(self.far[2], 2))
+            .min(F8::splat(tmax));
         let mut tns = [0.0; W];
-        for (h, tn_out) in tns.chunks_exact_mut(4).enumerate() {
-            let t = |i: usize, a: usize| (n.b[i][h] - self.o[a]) * self.inv[a];
-            let tn = t(self.near[0], 0)
-                .max(t(self.near[1], 1))
-                .max(t(self.near[2], 2))
-                .max(self.tmin);
-            let tf = t(self.far[0], 0)
-                .min(t(self.far[1], 1))
-                .min(t(self.far[2], 2))
-                .min(Vec4::splat(tmax));
-            mask |= tn.cmple(tf * ROBUST).bitmask() << (4 * h);
-            tn.write_to_slice(tn_out);
-        }
-        (mask, tns)
+        tn.store(&mut tns);
+        (tn.le_mask(tf.mul(F8::splat(ROBUST))), tns)
     }
 }
 
@@ -138,12 +133,12 @@ impl WideBvh {
         let me = self.nodes.len();
         self.nodes.push(Node {
             b: [
-                [Vec4::INFINITY; H],
-                [Vec4::NEG_INFINITY; H],
-                [Vec4::INFINITY; H],
-                [Vec4::NEG_INFINITY; H],
-                [Vec4::INFINITY; H],
-                [Vec4::NEG_INFINITY; H],
+                [f32::INFINITY; W],
+                [f32::NEG_INFINITY; W],
+                [f32::INFINITY; W],
+                [f32::NEG_INFINITY; W],
+                [f32::INFINITY; W],
+                [f32::NEG_INFINITY; W],
             ],
             child: [EMPTY; W],
         });
@@ -165,8 +160,8 @@ impl WideBvh {
                 .into_iter()
                 .enumerate()
             {
-                node.b[2 * axis][lane / 4][lane % 4] = lo;
-                node.b[2 * axis + 1][lane / 4][lane % 4] = hi;
+                node.b[2 * axis][lane] = lo;
+                node.b[2 * axis + 1][lane] = hi;
             }
         }
         depth
@@ -357,15 +352,15 @@ mod tests {
                 for lane in 0..W {
                     let c = node.child[lane];
                     if c == EMPTY {
-                        assert!(node.b[0][lane / 4][lane % 4] > node.b[1][lane / 4][lane % 4]);
+                        assert!(node.b[0][lane] > node.b[1][lane]);
                     } else if c & LEAF != 0 {
                         let (first, count) = bvh.leaves[(c & !LEAF) as usize];
                         for p in first as usize..(first + count) as usize {
                             seen[p] += 1;
                             let b = aabbs[bvh2.primitive_indices[p] as usize];
-                            let (h, l) = (lane / 4, lane % 4);
-                            assert!(node.b[0][h][l] <= b.min.x && b.max.x <= node.b[1][h][l]);
-                            assert!(node.b[4][h][l] <= b.min.z && b.max.z <= node.b[5][h][l]);
+                            let l = lane;
+                            assert!(node.b[0][l] <= b.min.x && b.max.x <= node.b[1][l]);
+                            assert!(node.b[4][l] <= b.min.z && b.max.z <= node.b[5][l]);
                         }
                     } else {
                         stack.push(c);

@@ -2,6 +2,7 @@
 
 pub mod accel;
 mod bvh;
+mod lanes8;
 mod refine;
 pub mod shape;
 pub mod watertight;
