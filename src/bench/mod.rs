@@ -32,6 +32,12 @@ pub struct BenchArgs {
     /// Timed repetitions; the fastest is reported (the others measure interference).
     #[arg(long, default_value_t = 3)]
     pub repeat: u32,
+    /// Largest triangle count of the triangle-scaling sweep (1e3, 1e4, ... up to this).
+    #[arg(long, default_value_t = 1_000_000)]
+    pub max_triangles: usize,
+    /// Largest emitter count of the emitter-scaling sweep (1, 10, ... up to this).
+    #[arg(long, default_value_t = 10_000)]
+    pub max_emitters: usize,
     /// Output CSV.
     #[arg(long, default_value = "reports/bench/bench.csv")]
     pub out: PathBuf,
@@ -110,7 +116,6 @@ fn throughput(
     w as f64 * h as f64 * spp as f64 / best
 }
 
-/// Peak resident memory of this process in bytes (Linux), if known.
 /// Nanoseconds per emitter choice (one uniform number in, emitter and pmf out), best of 3
 /// runs of 2^22 choices. The numbers jump around the unit interval (golden-ratio sequence) as
 /// a render's do, so table lookups are not sequential.
@@ -133,6 +138,7 @@ fn choice_ns(scene: &crate::scene::Scene, sel: EmitterSelection) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Peak resident memory of this process in bytes (Linux), if known.
 fn peak_memory() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
@@ -163,8 +169,10 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         let scene = open_scene(path, &[("res".into(), a.res.to_string())])?;
         let name = path.display().to_string();
         for strategy in bench_strategies() {
+            let mut by_threads = Vec::new();
             for &threads in &a.threads {
                 let sps = throughput(&scene, strategy, a.spp, threads, a.repeat);
+                by_threads.push((threads, sps));
                 println!(
                     "  {:<34} {:<26} {:>7} {:>12.2}",
                     name,
@@ -181,6 +189,29 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                     value: sps,
                     unit: "samples/s",
                 });
+            }
+            // Speed-up from the fewest to the most threads measured.
+            let lo = by_threads.iter().min_by_key(|t| t.0);
+            let hi = by_threads.iter().max_by_key(|t| t.0);
+            if let (Some(&(t1, s1)), Some(&(t2, s2))) = (lo, hi) {
+                if t2 > t1 {
+                    println!(
+                        "  {:<34} {:<26} {:>7} {:>11.2}x",
+                        "",
+                        "",
+                        format!("{t1}->{t2}"),
+                        s2 / s1
+                    );
+                    rows.push(Row {
+                        section: "thread_scaling",
+                        scene: name.clone(),
+                        strategy: strategy.label(),
+                        threads: t2,
+                        n: t1 as u64,
+                        value: s2 / s1,
+                        unit: "speed-up",
+                    });
+                }
             }
         }
         // The ray-tracing limit for the same ray mix, on one thread, against the 1-thread
@@ -227,12 +258,17 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         "per-sample cost as the scene grows ({} threads, power MIS):",
         max_threads
     );
+    let mut tri_costs = Vec::new();
     for n in [1_000usize, 10_000, 100_000, 1_000_000] {
+        if n > a.max_triangles {
+            break;
+        }
         let scene =
             crate::scene::Scene::build(scaling::tessellated(n)).map_err(|e| e.to_string())?;
         let sps = throughput(&scene, mis, 16, max_threads, a.repeat);
         let tris = scene.accel.primitive_count() as u64;
         println!("  {:>9} triangles: {:>8.1} ns/sample", tris, 1e9 / sps);
+        tri_costs.push(1e9 / sps);
         rows.push(Row {
             section: "scaling_triangles",
             scene: "tessellated sphere".into(),
@@ -243,12 +279,18 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             unit: "ns/sample",
         });
     }
+    if let (Some(first), Some(last)) = (tri_costs.first(), tri_costs.last()) {
+        println!("  growth over the sweep: {:.2}x", last / first);
+    }
     for sel in [EmitterSelection::Uniform, EmitterSelection::Power] {
         let s = Strategy {
             selection: sel,
             ..mis
         };
         for n in [1usize, 10, 100, 1_000, 10_000] {
+            if n > a.max_emitters {
+                break;
+            }
             let scene =
                 crate::scene::Scene::build(scaling::many_lights(n)).map_err(|e| e.to_string())?;
             let sps = throughput(&scene, s, 16, max_threads, a.repeat);

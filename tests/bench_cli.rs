@@ -1,0 +1,73 @@
+//! End to end through `directlab bench` at toy sizes: every section the speed goals are read
+//! from is printed and written to the CSV, with finite, positive numbers. (The numbers
+//! themselves are the benchmark's business, not a test's.)
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::process::Command;
+
+#[test]
+fn bench_writes_every_section() {
+    let dir = std::env::temp_dir().join(format!("directlab-bench-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("bench.csv");
+    let cbox = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cbox/cbox.xml");
+    let o = Command::new(env!("CARGO_BIN_EXE_directlab"))
+        .args(["bench", "--scene", cbox.to_str().unwrap()])
+        .args([
+            "--spp",
+            "1",
+            "--res",
+            "16",
+            "--repeat",
+            "1",
+            "--threads",
+            "1,2",
+        ])
+        .args(["--max-triangles", "10000", "--max-emitters", "10"])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .expect("run directlab");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for printed in [
+        "M samples/s",
+        "1->2",
+        "ray-tracing limit",
+        "raw obvhs",
+        "growth over",
+    ] {
+        assert!(
+            stdout.contains(printed),
+            "{printed} missing from:\n{stdout}"
+        );
+    }
+
+    let mut r = csv::Reader::from_path(&out).unwrap();
+    let mut sections: HashMap<String, usize> = HashMap::new();
+    for row in r.records() {
+        let row = row.unwrap();
+        let value: f64 = row[5].parse().unwrap();
+        let what = format!("{} {} {}", &row[0], &row[2], &row[4]);
+        // The share outside traversal is a difference of two timings: at toy sizes it may be
+        // anything, but it is a number.
+        if row[2].ends_with("share_outside_traversal") {
+            assert!(value.is_finite(), "{what}: {value}");
+        } else {
+            assert!(value.is_finite() && value > 0.0, "{what}: {value}");
+        }
+        *sections.entry(row[0].to_string()).or_default() += 1;
+    }
+    let strategies = 7;
+    assert_eq!(sections["throughput"], strategies * 2, "{sections:?}");
+    assert_eq!(sections["thread_scaling"], strategies, "{sections:?}");
+    assert_eq!(sections["ray_limit"], 5, "{sections:?}");
+    assert_eq!(sections["scaling_triangles"], 2, "{sections:?}");
+    // Two selectors (uniform, power) at 1 and 10 emitters.
+    assert_eq!(sections["scaling_emitters"], 4, "{sections:?}");
+    assert_eq!(sections["emitter_choice"], 4, "{sections:?}");
+    assert_eq!(sections["peak_memory"], 1, "{sections:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
