@@ -27,13 +27,25 @@ pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
     if o.x == 0.0 && o.y == 0.0 {
         return Vec2::ZERO;
     }
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, PI / 4.0 * (o.y / o.x))
+    // Both wedges need sin and cos of an angle in [-pi/4, pi/4] only: the second wedge's
+    // angle pi/2 - phi swaps them.
+    if o.x.abs() > o.y.abs() {
+        let (s, c) = sin_cos_quarter(PI / 4.0 * (o.y / o.x));
+        Vec2::new(o.x * c, o.x * s)
     } else {
-        (o.y, PI / 2.0 - PI / 4.0 * (o.x / o.y))
-    };
-    let (s, c) = theta.sin_cos();
-    Vec2::new(r * c, r * s)
+        let (s, c) = sin_cos_quarter(PI / 4.0 * (o.x / o.y));
+        Vec2::new(o.y * s, o.y * c)
+    }
+}
+
+/// sin and cos of |x| <= pi/4 by Cephes' minimax polynomials (a few ulp): no range reduction
+/// and no libm call, which cost 3 % of a diffuse scene's render time.
+#[inline]
+fn sin_cos_quarter(x: f32) -> (f32, f32) {
+    let z = x * x;
+    let s = x + x * z * (-1.666_665_5e-1 + z * (8.332_161e-3 + z * -1.951_529_6e-4));
+    let c = 1.0 - 0.5 * z + z * z * (4.166_664_6e-2 + z * (-1.388_731_6e-3 + z * 2.443_315_7e-5));
+    (s, c)
 }
 
 /// 1D tent on [-1, 1] by inverting its CDF.
@@ -150,6 +162,23 @@ pub fn square_to_uniform_cone_pdf(v: Vec3, cos_max: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quarter_sin_cos_within_a_few_ulp() {
+        let n = 100_000;
+        let mut worst = 0.0f64;
+        for i in 0..=n {
+            let x = (i as f64 / n as f64 * 2.0 - 1.0) * std::f64::consts::FRAC_PI_4;
+            let (s, c) = sin_cos_quarter(x as f32);
+            let xs = x as f32 as f64;
+            worst = worst
+                .max((s as f64 - xs.sin()).abs())
+                .max((c as f64 - xs.cos()).abs());
+        }
+        // f32's ulp at 0.7-1.0 is 6e-8.
+        assert!(worst < 2.5e-7, "worst error {worst:e}");
+        assert_eq!(sin_cos_quarter(0.0), (0.0, 1.0));
+    }
     use crate::rng::Rng;
 
     /// Monte Carlo estimate of the integral of pdf over [-1,1]^2 (or the sphere), a check that
