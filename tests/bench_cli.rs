@@ -63,7 +63,7 @@ fn bench_writes_every_section() {
     let strategies = 7;
     assert_eq!(sections["throughput"], strategies * 2, "{sections:?}");
     assert_eq!(sections["thread_scaling"], strategies, "{sections:?}");
-    assert_eq!(sections["ray_limit"], 5, "{sections:?}");
+    assert_eq!(sections["ray_limit"], 6, "{sections:?}");
     assert_eq!(sections["scaling_triangles"], 2, "{sections:?}");
     // Two selectors (uniform, power) at 1 and 10 emitters.
     assert_eq!(sections["scaling_emitters"], 4, "{sections:?}");

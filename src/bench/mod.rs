@@ -222,9 +222,10 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         let render_sps = throughput(&scene, mis, a.spp, 1, a.repeat);
         let outside = 1.0 - limit.seconds_per_sample * render_sps;
         println!(
-            "  ray-tracing limit ({name}, 1 thread): {:.2} M closest-hit rays/s, {:.2} M occlusion rays/s; {:.2} M samples/s if tracing were all; {:.0}% of {} render time outside traversal",
+            "  ray-tracing limit ({name}, 1 thread): {:.2} M closest-hit rays/s, {:.2} M occlusion rays/s, {:.2} M BSDF-ray emitter queries/s; {:.2} M samples/s if tracing were all; {:.0}% of {} render time outside traversal",
             limit.closest_per_s / 1e6,
             limit.occlusion_per_s / 1e6,
+            limit.bsdf_query_per_s.unwrap_or(f64::NAN) / 1e6,
             1.0 / limit.seconds_per_sample / 1e6,
             outside * 100.0,
             mis.label()
@@ -238,6 +239,11 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         for (what, v, unit) in [
             ("closest_hit_rays", limit.closest_per_s, "rays/s"),
             ("occlusion_rays", limit.occlusion_per_s, "rays/s"),
+            (
+                "bsdf_emitter_query_rays",
+                limit.bsdf_query_per_s.unwrap_or(f64::NAN),
+                "rays/s",
+            ),
             ("share_outside_traversal", outside, "fraction"),
             ("obvhs_closest_hit_rays", raw.closest_per_s, "rays/s"),
             ("obvhs_occlusion_rays", raw.occlusion_per_s, "rays/s"),

@@ -1,5 +1,6 @@
 //! The ray-tracing limit: how fast the BVH alone traces the ray mix of a power-MIS render
-//! (per camera sample: one closest-hit camera ray, one shadow ray, one closest-hit BSDF ray).
+//! (per camera sample: one closest-hit camera ray, one shadow ray, one BSDF ray asked for the
+//! emitter it ends on, with the renderer's query: see `Scene::bsdf_ray_hit`).
 //!
 //! The mix is replayed rather than recorded, so the render loop carries no instrumentation:
 //! camera rays exactly as the renderer makes them, shadow rays to points drawn by the scene's
@@ -18,7 +19,8 @@ use std::time::Instant;
 pub struct RayMix {
     pub camera: Vec<Ray>,
     pub shadow: Vec<Ray>,
-    pub bsdf: Vec<Ray>,
+    /// BSDF rays with the triangle the emitter-only structure skips for them.
+    pub bsdf: Vec<(Ray, u32)>,
 }
 
 /// The ray mix of `spp` samples per pixel of the scene's camera.
@@ -49,7 +51,7 @@ pub fn ray_mix(scene: &Scene, spp: u32) -> RayMix {
                 }
                 let d =
                     Frame::from_normal(sp.ns).to_world(square_to_cosine_hemisphere(rng.next_2d()));
-                mix.bsdf.push(scene.spawn_ray(&sp, d));
+                mix.bsdf.push(scene.bsdf_ray(&sp, d));
             }
         }
     }
@@ -57,10 +59,13 @@ pub fn ray_mix(scene: &Scene, spp: u32) -> RayMix {
 }
 
 pub struct RayLimit {
-    /// Rays per second of closest-hit and occlusion queries, and of the whole mix.
+    /// Rays per second of closest-hit queries (camera and BSDF rays, so that directlab and
+    /// obvhs trace the same queries) and of occlusion queries.
     pub closest_per_s: f64,
     pub occlusion_per_s: f64,
-    /// Seconds the BVH needs for the mix of one camera sample.
+    /// BSDF rays per second with the renderer's emitter query (directlab only).
+    pub bsdf_query_per_s: Option<f64>,
+    /// Seconds the renderer's queries need for the mix of one camera sample.
     pub seconds_per_sample: f64,
 }
 
@@ -71,6 +76,7 @@ impl RayLimit {
         RayLimit {
             closest_per_s: n_closest / best.0,
             occlusion_per_s: mix.shadow.len() as f64 / best.1,
+            bsdf_query_per_s: None,
             seconds_per_sample: (best.0 + best.1) / mix.camera.len() as f64,
         }
     }
@@ -78,25 +84,47 @@ impl RayLimit {
 
 /// Times the mix on one thread, best of `repeat`.
 pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
-    let mut best = (f64::INFINITY, f64::INFINITY);
+    // Best seconds of: camera rays, BSDF rays as closest hits, BSDF rays as the renderer
+    // asks them, shadow rays.
+    let mut best = [f64::INFINITY; 4];
     let mut sink = 0usize;
+    let prim = |h: Option<Hit>| h.map_or(0, |h| h.sp.prim as usize & 1);
     for _ in 0..repeat.max(1) {
         let t = Instant::now();
-        for r in mix.camera.iter().chain(&mix.bsdf) {
-            sink += scene
-                .intersect(r)
-                .map_or(0, |h: Hit| h.sp.prim as usize & 1);
+        for r in &mix.camera {
+            sink += prim(scene.intersect(r));
         }
-        let closest = t.elapsed().as_secs_f64();
+        let camera = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        for (r, _) in &mix.bsdf {
+            sink += prim(scene.intersect(r));
+        }
+        let bsdf_closest = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        for (r, skip) in &mix.bsdf {
+            sink += prim(scene.bsdf_ray_hit(r, *skip));
+        }
+        let bsdf_query = t.elapsed().as_secs_f64();
         let t = Instant::now();
         for r in &mix.shadow {
             sink += scene.accel.occluded(r) as usize;
         }
         let occl = t.elapsed().as_secs_f64();
-        best = (best.0.min(closest), best.1.min(occl));
+        for (b, x) in best
+            .iter_mut()
+            .zip([camera, bsdf_closest, bsdf_query, occl])
+        {
+            *b = b.min(x);
+        }
     }
     std::hint::black_box(sink);
-    RayLimit::from_seconds(mix, best)
+    let [camera, bsdf_closest, bsdf_query, occl] = best;
+    RayLimit {
+        closest_per_s: (mix.camera.len() + mix.bsdf.len()) as f64 / (camera + bsdf_closest),
+        occlusion_per_s: mix.shadow.len() as f64 / occl,
+        bsdf_query_per_s: Some(mix.bsdf.len() as f64 / bsdf_query),
+        seconds_per_sample: (camera + bsdf_query + occl) / mix.camera.len() as f64,
+    }
 }
 
 /// The same mix through obvhs's own CwBvh traversal and triangle test (spheres use
@@ -145,7 +173,7 @@ pub fn measure_obvhs(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
     let mut sink = 0usize;
     for _ in 0..repeat.max(1) {
         let t = Instant::now();
-        for r in mix.camera.iter().chain(&mix.bsdf) {
+        for r in mix.camera.iter().chain(mix.bsdf.iter().map(|b| &b.0)) {
             let mut hit = obvhs::ray::RayHit::none();
             sink += bvh.ray_traverse(ray(r), &mut hit, prim) as usize;
         }

@@ -55,12 +55,22 @@ enum Prim {
 impl Accel {
     /// Builds over all shapes; zero-area triangles are left out since no ray can hit them.
     pub fn build(shapes: &[Shape]) -> Accel {
+        Accel::build_where(shapes, |_| true)
+    }
+
+    /// Builds over the shapes `keep` selects. Hits still name their shape by its index in
+    /// `shapes`; a surface point on a left-out shape has no triangle to skip here.
+    pub fn build_where(shapes: &[Shape], keep: impl Fn(&Shape) -> bool) -> Accel {
         // (primitive, its id in `refs`)
         let mut prims = Vec::new();
         let mut refs = Vec::new();
         let mut tri_base = Vec::new();
         let mut aabbs = Vec::new();
         for (si, shape) in shapes.iter().enumerate() {
+            if !keep(shape) {
+                tri_base.push(NO_SKIP);
+                continue;
+            }
             match &shape.kind {
                 ShapeKind::Mesh(m) => {
                     tri_base.push(refs.len() as u32);
@@ -211,7 +221,8 @@ impl Accel {
     /// True if anything blocks the ray within its interval.
     pub fn occluded(&self, ray: &Ray) -> bool {
         let (o, d, tmin, tmax) = (ray.o, ray.d, ray.tmin, ray.tmax);
-        let wr = WatertightRay::new(o, d);
+        // Set up on the first leaf: many occlusion rays (and most emitter pre-tests) reach none.
+        let mut wr = None;
         self.bvh.any(
             o,
             d,
@@ -220,6 +231,7 @@ impl Accel {
             #[inline(always)]
             |l, tmax| {
                 let leaf = &self.leaves[l];
+                let wr = wr.get_or_insert_with(|| WatertightRay::new(o, d));
                 (leaf.n_tris > 0 && wr.any(&leaf.tris, tmin, tmax, leaf.skip(ray.skip)))
                     || self.spheres[leaf.spheres.0 as usize..leaf.spheres.1 as usize]
                         .iter()

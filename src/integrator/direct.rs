@@ -184,8 +184,8 @@ impl<'a> Direct<'a> {
             return Rgb::ZERO;
         };
         let d = sh.frame.to_world(bs.wo);
-        let ray = scene.spawn_ray(&sh.sp, d);
-        let Some(hit) = scene.intersect_emitter(&ray) else {
+        let (ray, emitter_skip) = scene.bsdf_ray(&sh.sp, d);
+        let Some(hit) = scene.bsdf_ray_hit(&ray, emitter_skip) else {
             return Rgb::ZERO;
         };
         let Some((ei, e)) = scene.emitter_at(&hit.sp) else {

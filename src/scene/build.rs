@@ -7,7 +7,7 @@ use crate::bsdf::{
 };
 use crate::camera::Camera;
 use crate::emitter::{AreaLight, Emitter, LightSample, PointLight};
-use crate::geometry::{Accel, Hit, Mesh, Ray, Shape, ShapeKind, Sphere, SurfacePoint};
+use crate::geometry::{Accel, Hit, Mesh, Ray, Shape, ShapeKind, Sphere, SurfacePoint, NO_SKIP};
 use crate::math::{offset_origin, Rgb};
 use crate::sampling::microfacet::Microfacet;
 use crate::sampling::AliasTable;
@@ -34,6 +34,10 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub emitters: Vec<Emitter>,
     pub accel: Accel,
+    /// The emitting shapes alone, when they are at most a quarter of the surface area and half
+    /// the primitives: a BSDF ray that misses all of them cannot end on an emitter, and then
+    /// most BSDF rays miss (see `bsdf_ray_hit`).
+    pub emitter_accel: Option<Accel>,
     pub camera: Camera,
     pub warnings: Vec<String>,
 }
@@ -267,12 +271,31 @@ impl Scene {
             ));
         }
         let accel = Accel::build(&shapes);
+        // The emitter pre-test pays when most BSDF rays miss every emitter: the emitters'
+        // share of the surface area stands in for that chance, their share of the primitives
+        // for the pre-test's cost.
+        let area = |s: &Shape| match &s.kind {
+            ShapeKind::Mesh(m) => (0..m.indices.len())
+                .map(|t| m.triangle_area(t) as f64)
+                .sum(),
+            ShapeKind::Sphere(sph) => sph.area() as f64,
+        };
+        let all_area: f64 = shapes.iter().map(area).sum();
+        let emitter_area: f64 = shapes
+            .iter()
+            .filter(|s| s.emitter.is_some())
+            .map(area)
+            .sum();
+        let emitter_accel = (4.0 * emitter_area <= all_area)
+            .then(|| Accel::build_where(&shapes, |s| s.emitter.is_some()))
+            .filter(|e| 2 * e.primitive_count() <= accel.primitive_count());
         let camera = Camera::new(&desc.camera, &desc.film);
         Ok(Scene {
             shapes,
             materials,
             emitters,
             accel,
+            emitter_accel,
             camera,
             warnings,
             desc,
@@ -290,6 +313,35 @@ impl Scene {
         let shapes = &self.shapes;
         self.accel
             .intersect_if(ray, shapes, |s| shapes[s].emitter.is_some())
+    }
+
+    /// The ray a BSDF sample leaving `sp` in direction `d` traces, and the triangle the
+    /// emitter-only structure must skip for it (see `bsdf_ray_hit`).
+    #[inline]
+    pub fn bsdf_ray(&self, sp: &SurfacePoint, d: glam::Vec3) -> (Ray, u32) {
+        let skip = self
+            .emitter_accel
+            .as_ref()
+            .map_or(NO_SKIP, |e| e.skip_id(sp));
+        (self.spawn_ray(sp, d), skip)
+    }
+
+    /// `intersect_emitter` for a BSDF ray, with the same answer: first an any-hit query
+    /// against the emitters alone; only a ray that hits one needs the full closest-hit query.
+    /// (A lane that is a hit for a closest-hit query, whose interval only shrinks, is a hit
+    /// for the any-hit query over the whole interval: the watertight test's decisions are
+    /// monotone in tmax.)
+    #[inline]
+    pub fn bsdf_ray_hit(&self, ray: &Ray, emitter_skip: u32) -> Option<Hit> {
+        if let Some(e) = &self.emitter_accel {
+            if !e.occluded(&Ray {
+                skip: emitter_skip,
+                ..*ray
+            }) {
+                return None;
+            }
+        }
+        self.intersect_emitter(ray)
     }
 
     /// Mutual visibility of a surface point and a point on a light. Both ends are moved off

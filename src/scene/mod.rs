@@ -44,4 +44,6 @@ pub use error::SceneError;
 pub use loader::{load_scene, load_scene_str, Dialect};
 
 #[cfg(test)]
+mod bsdf_ray_tests;
+#[cfg(test)]
 mod bundled_tests;

@@ -1,0 +1,87 @@
+//! The emitter pre-test of BSDF rays (`Scene::bsdf_ray_hit`) gives exactly the answer of the
+//! full closest-hit query (`intersect_emitter`) on the bundled scenes that use it, for rays
+//! leaving ordinary surfaces and rays leaving the lights themselves.
+
+use super::Scene;
+use crate::emitter::LightSampling;
+use crate::geometry::Hit;
+use crate::rng::Rng;
+use crate::sampling::warps::square_to_uniform_sphere;
+use std::path::Path;
+
+fn open(rel: &str) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(rel);
+    let desc = super::load_scene(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+    Scene::build(desc).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn same(a: &Option<Hit>, b: &Option<Hit>) -> bool {
+    match (a, b) {
+        (None, None) => true,
+        (Some(a), Some(b)) => {
+            a.t.to_bits() == b.t.to_bits() && a.sp.shape == b.sp.shape && a.sp.prim == b.sp.prim
+        }
+        _ => false,
+    }
+}
+
+/// From each of `n` camera hits: a ray in a uniform direction and one towards a light point;
+/// from the light points seen there, a ray in a uniform direction. Returns how many rays from
+/// surfaces and from lights hit an emitter.
+fn check(scene: &Scene, n: u32) -> (u32, u32) {
+    assert!(scene.emitter_accel.is_some(), "pre-test not in use");
+    let cam = &scene.camera;
+    let mut rng = Rng::new(11, 5);
+    let (mut from_surface, mut from_light) = (0, 0);
+    let compare = |sp: &crate::geometry::SurfacePoint, d: glam::Vec3| {
+        let (ray, skip) = scene.bsdf_ray(sp, d);
+        let (fast, full) = (
+            scene.bsdf_ray_hit(&ray, skip),
+            scene.intersect_emitter(&ray),
+        );
+        assert!(same(&fast, &full), "ray {ray:?}: {fast:?} vs {full:?}");
+        full.is_some() as u32
+    };
+    for _ in 0..n {
+        let (x, y) = (rng.next_u32() % cam.width, rng.next_u32() % cam.height);
+        let Some(hit) = scene.intersect(&cam.generate_ray(x, y, &mut rng)) else {
+            continue;
+        };
+        from_surface += compare(&hit.sp, square_to_uniform_sphere(rng.next_2d()));
+        let e = rng.next_u32() as usize % scene.emitters.len();
+        let (u_prim, u) = (rng.next_f32(), rng.next_2d());
+        let Some(ls) =
+            scene.emitters[e].sample(&scene.shapes, hit.sp.p, u_prim, u, LightSampling::Area)
+        else {
+            continue;
+        };
+        let to_light = ls.p - hit.sp.p;
+        from_surface += compare(&hit.sp, to_light);
+        if let Some(on_light) = scene.intersect(&scene.spawn_ray(&hit.sp, to_light)) {
+            if scene.emitter_at(&on_light.sp).is_some() {
+                from_light += compare(&on_light.sp, square_to_uniform_sphere(rng.next_2d()));
+            }
+        }
+    }
+    (from_surface, from_light)
+}
+
+#[test]
+fn pretest_matches_the_full_query() {
+    for rel in [
+        "cbox/cbox.xml",
+        "cbox-meshlight/cbox-meshlight.xml",
+        "cbox-twolights/cbox-twolights.xml",
+        "veach-mis/veach-mis.xml",
+    ] {
+        let (surface, light) = check(&open(rel), 20_000);
+        // Enough rays end on a light for a wrong skip or a missed emitter to show.
+        assert!(
+            surface > 100,
+            "{rel}: {surface} rays from surfaces hit a light"
+        );
+        eprintln!("{rel}: {surface} surface rays and {light} light-origin rays hit a light");
+    }
+}
