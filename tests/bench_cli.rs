@@ -2,18 +2,17 @@
 //! from is printed and written to the CSV, with finite, positive numbers. (The numbers
 //! themselves are the benchmark's business, not a test's.)
 
+mod common;
+
+use common::{directlab, repo, run, scratch};
 use std::collections::HashMap;
-use std::path::Path;
-use std::process::Command;
 
 #[test]
 fn bench_writes_every_section() {
-    let dir = std::env::temp_dir().join(format!("directlab-bench-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("bench");
     let out = dir.join("bench.csv");
-    let cbox = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cbox/cbox.xml");
-    let o = Command::new(env!("CARGO_BIN_EXE_directlab"))
+    let cbox = repo("scenes/cbox/cbox.xml");
+    let o = run(directlab()
         .args(["bench", "--scene", cbox.to_str().unwrap()])
         .args([
             "--spp",
@@ -27,9 +26,7 @@ fn bench_writes_every_section() {
         ])
         .args(["--max-triangles", "10000", "--max-emitters", "10"])
         .arg("--out")
-        .arg(&out)
-        .output()
-        .expect("run directlab");
+        .arg(&out));
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for printed in [

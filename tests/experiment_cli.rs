@@ -1,31 +1,20 @@
 //! End to end through `directlab run --quick`, as a user runs it: results, plots and report
 //! appear, and a second run resumes instead of rendering again.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn repo(p: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(p)
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("directlab-exp-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use common::{directlab, repo, run, scratch};
+use std::path::Path;
+use std::process::Output;
 
 /// `directlab run EXP --out OUT`, which must succeed.
 fn run_ok(exp: &Path, out: &Path) {
-    let o = Command::new(env!("CARGO_BIN_EXE_directlab"))
-        .args(["run", exp.to_str().unwrap(), "--out", out.to_str().unwrap()])
-        .output()
-        .unwrap();
+    let o = run(directlab().args(["run", exp.to_str().unwrap(), "--out", out.to_str().unwrap()]));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
 fn run_quick(exp: &str, out: &Path) -> Output {
-    let o = Command::new(env!("CARGO_BIN_EXE_directlab"))
+    run(directlab()
         .args([
             "run",
             repo(exp).to_str().unwrap(),
@@ -34,13 +23,7 @@ fn run_quick(exp: &str, out: &Path) -> Output {
             "2",
         ])
         .arg("--out")
-        .arg(out)
-        .output()
-        .expect("run directlab");
-    if !o.status.success() {
-        eprintln!("stderr: {}", String::from_utf8_lossy(&o.stderr));
-    }
-    o
+        .arg(out))
 }
 
 #[test]

@@ -7,6 +7,7 @@
 //! to part of its integrand (e.g. BSDF sampling of a 1e-8 sr light) is checked for finiteness
 //! only.
 
+use common::{directlab, repo, run, scratch};
 use directlab::experiment::cases::Case;
 use directlab::experiment::probe::accumulate::{self, Accumulation};
 use directlab::experiment::probe::closed_form;
@@ -17,12 +18,10 @@ use directlab::experiment::{load, Resolved};
 use directlab::integrator::Strategy;
 use directlab::scene::{load_scene, Scene};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
-fn repo(p: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(p)
-}
+mod common;
 
 fn experiment(quick: bool) -> Resolved {
     load(&repo("experiments/extreme.toml"), quick).expect("extreme.toml loads")
@@ -40,24 +39,9 @@ fn strategy(exp: &Resolved, scene: &Scene, name: &str) -> Strategy {
         .apply(Strategy::from_desc(&scene.desc.integrator))
 }
 
-fn directlab(args: &[&str], out: &Path) -> Output {
-    let o = Command::new(env!("CARGO_BIN_EXE_directlab"))
-        .args(args)
-        .arg("--out")
-        .arg(out)
-        .output()
-        .expect("run directlab");
-    if !o.status.success() {
-        eprintln!("stderr: {}", String::from_utf8_lossy(&o.stderr));
-    }
-    o
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("directlab-extreme-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// `directlab ARGS --out OUT`.
+fn directlab_out(args: &[&str], out: &Path) -> Output {
+    run(directlab().args(args).arg("--out").arg(out))
 }
 
 fn read_rows(csv: &Path) -> Vec<Row> {
@@ -99,7 +83,7 @@ fn a_stale_reference_value_stops_the_run_naming_file_case_and_key() {
     assert_ne!(stale, text.replace("\"../scenes/", &format!("\"{scenes}/")));
     let file = dir.join("stale.toml");
     std::fs::write(&file, stale).unwrap();
-    let o = directlab(&["run", file.to_str().unwrap(), "--quick"], &dir);
+    let o = directlab_out(&["run", file.to_str().unwrap(), "--quick"], &dir);
     assert!(!o.status.success());
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
@@ -182,7 +166,7 @@ fn quick_suite_through_the_cli_is_finite_unbiased_and_resumes() {
     let out = scratch("quick");
     let exp = experiment(true);
     // The alias first, then the runner's own command: both run experiments/extreme.toml.
-    let first = directlab(&["extreme", "--quick", "--threads", "2"], &out);
+    let first = directlab_out(&["extreme", "--quick", "--threads", "2"], &out);
     assert!(first.status.success());
     let dir = out.join("extreme-quick");
     let csv = dir.join("results.csv");
@@ -209,7 +193,7 @@ fn quick_suite_through_the_cli_is_finite_unbiased_and_resumes() {
         assert!(a.f64_rel_error < 1e-12, "{a:?}");
     }
 
-    let run = || directlab(&["run", "experiments/extreme.toml", "--quick"], &out);
+    let run = || directlab_out(&["run", "experiments/extreme.toml", "--quick"], &out);
     let text = std::fs::read_to_string(&csv).unwrap();
     let second = run();
     assert!(second.status.success());

@@ -2,37 +2,15 @@
 
 use directlab::film::read_exr;
 use directlab::metrics::compare_regions;
+mod common;
+
+use common::{directlab, repo, run, scratch};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_directlab"))
-}
-
-fn repo(p: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(p)
-}
-
-/// A fresh, empty directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("directlab-e2e-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(cmd: &mut Command) -> Output {
-    let out = cmd.output().expect("run directlab");
-    if !out.status.success() {
-        eprintln!("stderr: {}", String::from_utf8_lossy(&out.stderr));
-    }
-    out
-}
 
 #[test]
 fn renders_bundled_cornell_box_with_exr_png_variance_and_stats() {
     let d = scratch("cbox");
-    let out = run(bin()
+    let out = run(directlab()
         .args(["render", repo("scenes/cbox/cbox.xml").to_str().unwrap()])
         .args(["--spp", "4", "-D", "res=32", "--threads", "2"])
         .arg("--out")
@@ -68,7 +46,7 @@ fn renders_bundled_cornell_box_with_exr_png_variance_and_stats() {
 fn same_seed_gives_identical_files_for_one_and_two_threads() {
     let d = scratch("threads");
     for t in ["1", "2"] {
-        let out = run(bin()
+        let out = run(directlab()
             .args(["render", repo("scenes/cbox/cbox.xml").to_str().unwrap()])
             .args(["--spp", "3", "-D", "res=24", "--seed", "5", "--threads", t])
             .arg("--out")
@@ -90,7 +68,7 @@ fn both_dialects_of_the_cornell_box_render_the_same_image() {
         ("mi", "scenes/cbox/cbox.xml"),
         ("nori", "scenes/cbox/cbox-nori.xml"),
     ] {
-        let out = run(bin()
+        let out = run(directlab()
             .args([
                 "render",
                 repo(scene).to_str().unwrap(),
@@ -135,7 +113,7 @@ fn write_scene(dir: &Path, body: &str) -> PathBuf {
 
 /// A failing render must say what is wrong (file, line, element) and leave no output behind.
 fn assert_fails_cleanly(dir: &Path, scene: &Path, expect: &[&str]) {
-    let out = bin()
+    let out = directlab()
         .arg("render")
         .arg(scene)
         .arg("--out")
@@ -199,7 +177,7 @@ fn degenerate_triangles_in_an_emitter_are_a_documented_warning() {
         &d,
         r#"<shape type="obj"><string name="filename" value="light.obj"/><emitter type="area"/></shape>"#,
     );
-    let out = run(bin()
+    let out = run(directlab()
         .arg("render")
         .arg(&s)
         .arg("--out")
@@ -215,7 +193,7 @@ fn degenerate_triangles_in_an_emitter_are_a_documented_warning() {
 #[test]
 fn defines_override_defaults() {
     let d = scratch("defines");
-    let out = run(bin()
+    let out = run(directlab()
         .args([
             "render",
             repo("scenes/cbox/cbox.xml").to_str().unwrap(),
@@ -228,7 +206,7 @@ fn defines_override_defaults() {
         .arg(d.join("a.exr")));
     assert!(out.status.success());
     assert_eq!(read_exr(&d.join("a.exr")).unwrap().width, 16);
-    let bad = bin()
+    let bad = directlab()
         .args([
             "render",
             repo("scenes/cbox/cbox.xml").to_str().unwrap(),
