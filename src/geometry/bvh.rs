@@ -1,6 +1,6 @@
 //! An 8-wide BVH collapsed from obvhs's binary BVH (PLOC build plus reinsertion) and traversed
-//! with one 8-lane box test per node (see `lanes8`). (8 children beat 4 by 5-8 % on cbox and veach-mis
-//! rays: fewer nodes on the way down, fewer unpredictable branches.)
+//! with one 8-lane box test per node (see `lanes8`). (8 children beat 4 by 5-8 % on cbox and
+//! veach-mis rays: fewer nodes on the way down, fewer unpredictable branches.)
 //!
 //! Why not obvhs's own CwBvh traversal: its 8-bit quantised child boxes cost a decode per node,
 //! and it culls boxes entered closer than an absolute t of 1e-4, which leaks rays at small scene
@@ -9,7 +9,7 @@
 //! through the shared edge of two triangles in different leaves enters both leaves.
 
 use super::lanes8::F8;
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use obvhs::{aabb::Aabb, bvh2::Bvh2};
 
 /// Child slot tags: a leaf is `LEAF | leaf index`, an internal child is its node index, an
@@ -54,7 +54,7 @@ impl BoxRay {
     fn new(o: Vec3, d: Vec3, tmin: f32) -> Self {
         // 1/0 = inf would meet a zero (b - o) and give NaN; f32::MAX keeps every product
         // ordered (0 stays 0, anything else overflows to the right infinity).
-        let inv = Vec3::from(glam::Vec3A::ONE / glam::Vec3A::from(d));
+        let inv = Vec3::from(Vec3A::ONE / Vec3A::from(d));
         let inv = inv.clamp(Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX));
         let neg = |x: f32| x.is_sign_negative() as usize;
         let near = [neg(inv.x), 2 + neg(inv.y), 4 + neg(inv.z)];
@@ -358,9 +358,8 @@ mod tests {
                         for p in first as usize..(first + count) as usize {
                             seen[p] += 1;
                             let b = aabbs[bvh2.primitive_indices[p] as usize];
-                            let l = lane;
-                            assert!(node.b[0][l] <= b.min.x && b.max.x <= node.b[1][l]);
-                            assert!(node.b[4][l] <= b.min.z && b.max.z <= node.b[5][l]);
+                            assert!(node.b[0][lane] <= b.min.x && b.max.x <= node.b[1][lane]);
+                            assert!(node.b[4][lane] <= b.min.z && b.max.z <= node.b[5][lane]);
                         }
                     } else {
                         stack.push(c);

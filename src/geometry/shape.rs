@@ -35,6 +35,18 @@ pub struct Shape {
     pub emitter: Option<u32>,
 }
 
+impl Shape {
+    /// Surface area; a mesh's zero-area triangles add nothing.
+    pub fn area(&self) -> f64 {
+        match &self.kind {
+            ShapeKind::Mesh(m) => (0..m.indices.len())
+                .map(|t| m.triangle_area(t) as f64)
+                .sum(),
+            ShapeKind::Sphere(s) => s.area() as f64,
+        }
+    }
+}
+
 impl Mesh {
     pub fn new(positions: Vec<Vec3>, normals: Option<Vec<Vec3>>, indices: Vec<[u32; 3]>) -> Self {
         let face = indices

@@ -42,6 +42,23 @@ pub struct Scene {
     pub warnings: Vec<String>,
 }
 
+/// The emitter-only structure of the BSDF-ray pre-test (`Scene::bsdf_ray_hit`), where it
+/// pays: most BSDF rays must miss every emitter (the emitters' share of the surface area stands
+/// in for that chance), and the pre-test must be cheap (their share of the primitives).
+fn emitter_pretest(shapes: &[Shape], emitters: &[Emitter], accel: &Accel) -> Option<Accel> {
+    let all_area: f64 = shapes.iter().map(Shape::area).sum();
+    let emitter_area: f64 = emitters
+        .iter()
+        .map(|e| match e {
+            Emitter::Area(a) => a.area as f64,
+            Emitter::Point(_) => 0.0,
+        })
+        .sum();
+    (4.0 * emitter_area <= all_area)
+        .then(|| Accel::build_where(shapes, |s| s.emitter.is_some()))
+        .filter(|e| 2 * e.primitive_count() <= accel.primitive_count())
+}
+
 fn err(origin: &str, message: impl Into<String>) -> BuildError {
     BuildError {
         origin: origin.to_string(),
@@ -271,24 +288,7 @@ impl Scene {
             ));
         }
         let accel = Accel::build(&shapes);
-        // The emitter pre-test pays when most BSDF rays miss every emitter: the emitters'
-        // share of the surface area stands in for that chance, their share of the primitives
-        // for the pre-test's cost.
-        let area = |s: &Shape| match &s.kind {
-            ShapeKind::Mesh(m) => (0..m.indices.len())
-                .map(|t| m.triangle_area(t) as f64)
-                .sum(),
-            ShapeKind::Sphere(sph) => sph.area() as f64,
-        };
-        let all_area: f64 = shapes.iter().map(area).sum();
-        let emitter_area: f64 = shapes
-            .iter()
-            .filter(|s| s.emitter.is_some())
-            .map(area)
-            .sum();
-        let emitter_accel = (4.0 * emitter_area <= all_area)
-            .then(|| Accel::build_where(&shapes, |s| s.emitter.is_some()))
-            .filter(|e| 2 * e.primitive_count() <= accel.primitive_count());
+        let emitter_accel = emitter_pretest(&shapes, &emitters, &accel);
         let camera = Camera::new(&desc.camera, &desc.film);
         Ok(Scene {
             shapes,
