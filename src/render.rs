@@ -48,8 +48,9 @@ fn render_pixel(direct: &Direct, x: u32, y: u32, settings: &RenderSettings) -> P
     // Welford's update in f64: stable for millions of samples of very different size.
     let (mut mean, mut m2) = ([0.0f64; 3], [0.0f64; 3]);
     let mut non_finite = 0;
+    let key = Rng::pixel_key(settings.seed, pixel);
     for s in 0..settings.spp {
-        let mut rng = Rng::for_sample(settings.seed, pixel, s as u64);
+        let mut rng = Rng::for_pixel_sample(key, s as u64);
         let ray = cam.generate_ray(x, y, &mut rng);
         let mut v = direct.li(&ray, &mut rng);
         if !v.is_finite() {

@@ -37,7 +37,19 @@ impl Rng {
     /// The generator for one camera sample of one pixel.
     #[inline]
     pub fn for_sample(seed: u64, pixel: u64, sample: u64) -> Self {
-        let key = mix64(mix64(seed ^ mix64(pixel)) ^ sample);
+        Rng::for_pixel_sample(Rng::pixel_key(seed, pixel), sample)
+    }
+
+    /// The part of `for_sample`'s seeding shared by all samples of a pixel.
+    #[inline]
+    pub fn pixel_key(seed: u64, pixel: u64) -> u64 {
+        mix64(seed ^ mix64(pixel))
+    }
+
+    /// `for_sample(seed, pixel, sample)` from `pixel_key(seed, pixel)`.
+    #[inline]
+    pub fn for_pixel_sample(pixel_key: u64, sample: u64) -> Self {
+        let key = mix64(pixel_key ^ sample);
         Rng::new(key, mix64(key ^ 0x5851_F42D_4C95_7F2D))
     }
 
@@ -80,6 +92,15 @@ mod tests {
         let mut b = Rng::for_sample(7, 123, 4);
         for _ in 0..100 {
             assert_eq!(a.next_u32(), b.next_u32());
+        }
+    }
+
+    #[test]
+    fn pixel_key_seeding_is_for_sample() {
+        for (seed, pixel, s) in [(0, 0, 0), (7, 123, 4), (u64::MAX, 1 << 40, 99)] {
+            let mut a = Rng::for_sample(seed, pixel, s);
+            let mut b = Rng::for_pixel_sample(Rng::pixel_key(seed, pixel), s);
+            assert!((0..8).all(|_| a.next_u32() == b.next_u32()));
         }
     }
 

@@ -218,6 +218,12 @@ impl Accel {
         Some(Hit { t, sp })
     }
 
+    /// False only if the ray can hit nothing here (see `WideBvh::may_enter`).
+    #[inline(always)]
+    pub fn may_hit(&self, ray: &Ray) -> bool {
+        self.bvh.may_enter(ray.o, ray.d, ray.tmin, ray.tmax)
+    }
+
     /// True if anything blocks the ray within its interval.
     pub fn occluded(&self, ray: &Ray) -> bool {
         let (o, d, tmin, tmax) = (ray.o, ray.d, ray.tmin, ray.tmax);

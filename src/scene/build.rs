@@ -331,8 +331,17 @@ impl Scene {
     /// (A lane that is a hit for a closest-hit query, whose interval only shrinks, is a hit
     /// for the any-hit query over the whole interval: the watertight test's decisions are
     /// monotone in tmax.)
-    #[inline]
+    #[inline(always)]
     pub fn bsdf_ray_hit(&self, ray: &Ray, emitter_skip: u32) -> Option<Hit> {
+        match &self.emitter_accel {
+            // Inline, the scalar box reject that most BSDF rays end at.
+            Some(e) if !e.may_hit(ray) => None,
+            _ => self.bsdf_ray_hit_traced(ray, emitter_skip),
+        }
+    }
+
+    #[inline(never)]
+    fn bsdf_ray_hit_traced(&self, ray: &Ray, emitter_skip: u32) -> Option<Hit> {
         if let Some(e) = &self.emitter_accel {
             if !e.occluded(&Ray {
                 skip: emitter_skip,
