@@ -10,7 +10,7 @@
 //! the pure ones, so no strategy loses them and none counts them twice.
 
 use super::Strategy;
-use crate::bsdf::Material;
+use crate::bsdf::{BsdfSample, Material};
 use crate::emitter::{EmitterSelector, LightSample};
 use crate::geometry::{Ray, SurfacePoint};
 use crate::math::{Frame, Rgb};
@@ -108,18 +108,28 @@ impl<'a> Direct<'a> {
                 }
             }
             StrategyKind::Mis => {
-                if !delta_bsdf {
-                    for _ in 0..s.emitter_samples {
-                        l += self.light_sample(&sh, rng, |pl, pb| {
-                            heuristic(s.heuristic, ne * pl, nb * pb)
-                        }) / ne;
-                    }
-                }
+                let light_w = |pl, pb| heuristic(s.heuristic, ne * pl, nb * pb);
                 let ne_drawn = if delta_bsdf { 0.0 } else { ne };
-                for _ in 0..s.bsdf_samples {
-                    l += self.bsdf_sample(&sh, rng, |pb, pl| {
-                        heuristic(s.heuristic, nb * pb, ne_drawn * pl)
-                    }) / nb;
+                let bsdf_w = |pb, pl| heuristic(s.heuristic, nb * pb, ne_drawn * pl);
+                let n_light = if delta_bsdf { 0 } else { s.emitter_samples };
+                for _ in 1..n_light {
+                    l += self.light_sample(&sh, rng, light_w) / ne;
+                }
+                // The last light sample and the first BSDF sample are drawn before either
+                // traces its ray (random numbers still in the same order): their square
+                // roots and divisions then overlap instead of waiting behind a traversal.
+                let mut n_bsdf = s.bsdf_samples;
+                if n_light > 0 && n_bsdf > 0 {
+                    let light = self.light_draw(&sh, rng);
+                    let bsdf = self.bsdf_draw(&sh, rng);
+                    l += self.light_finish(&sh, light, light_w) / ne;
+                    l += self.bsdf_finish(&sh, bsdf, bsdf_w) / nb;
+                    n_bsdf -= 1;
+                } else if n_light > 0 {
+                    l += self.light_sample(&sh, rng, light_w) / ne;
+                }
+                for _ in 0..n_bsdf {
+                    l += self.bsdf_sample(&sh, rng, bsdf_w) / nb;
                 }
             }
             StrategyKind::MisOneSample => {
@@ -144,19 +154,36 @@ impl<'a> Direct<'a> {
     /// other technique can produce it.
     #[inline]
     fn light_sample(&self, sh: &Shading, rng: &mut Rng, weight: impl Fn(f32, f32) -> f32) -> Rgb {
+        let drawn = self.light_draw(sh, rng);
+        self.light_finish(sh, drawn, weight)
+    }
+
+    /// The random half of a light sample: the emitter, its point and density.
+    #[inline(always)]
+    fn light_draw(&self, sh: &Shading, rng: &mut Rng) -> Option<(LightSample, f32)> {
         let scene = self.scene;
-        let Some((ei, pmf)) = self.selector.sample(rng.next_f32()) else {
-            return Rgb::ZERO;
-        };
+        let (ei, pmf) = self.selector.sample(rng.next_f32())?;
         let u_prim = rng.next_f32();
         let u = rng.next_2d();
-        let Some(ls): Option<LightSample> = scene.emitters[ei].sample(
+        let ls = scene.emitters[ei].sample(
             &scene.shapes,
             sh.sp.p,
             u_prim,
             u,
             self.strategy.light_sampling,
-        ) else {
+        )?;
+        Some((ls, pmf))
+    }
+
+    /// The rest of a light sample: BSDF, visibility and weight.
+    #[inline(always)]
+    fn light_finish(
+        &self,
+        sh: &Shading,
+        drawn: Option<(LightSample, f32)>,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
+        let Some((ls, pmf)) = drawn else {
             return Rgb::ZERO;
         };
         let wo = sh.frame.to_local(ls.wi);
@@ -164,7 +191,7 @@ impl<'a> Direct<'a> {
         if f == Rgb::ZERO || ls.li == Rgb::ZERO {
             return Rgb::ZERO;
         }
-        if !scene.visible(&sh.sp, &ls) {
+        if !self.scene.visible(&sh.sp, &ls) {
             return Rgb::ZERO;
         }
         let p_light = pmf * ls.pdf;
@@ -177,10 +204,28 @@ impl<'a> Direct<'a> {
     /// Delta lobes are asked for their weight with p_light = 0 (light sampling cannot hit them).
     #[inline]
     fn bsdf_sample(&self, sh: &Shading, rng: &mut Rng, weight: impl Fn(f32, f32) -> f32) -> Rgb {
-        let scene = self.scene;
+        let drawn = self.bsdf_draw(sh, rng);
+        self.bsdf_finish(sh, drawn, weight)
+    }
+
+    /// The random half of a BSDF sample.
+    #[inline(always)]
+    fn bsdf_draw(&self, sh: &Shading, rng: &mut Rng) -> Option<BsdfSample> {
         let u1 = rng.next_f32();
         let u2 = rng.next_2d();
-        let Some(bs) = sh.mat.sample(sh.wi, u1, u2) else {
+        sh.mat.sample(sh.wi, u1, u2)
+    }
+
+    /// The rest of a BSDF sample: its ray, the emitter it reaches and the weight.
+    #[inline(always)]
+    fn bsdf_finish(
+        &self,
+        sh: &Shading,
+        drawn: Option<BsdfSample>,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
+        let scene = self.scene;
+        let Some(bs) = drawn else {
             return Rgb::ZERO;
         };
         let d = sh.frame.to_world(bs.wo);
