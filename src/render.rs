@@ -49,9 +49,18 @@ fn render_pixel(direct: &Direct, x: u32, y: u32, settings: &RenderSettings) -> P
     let (mut mean, mut m2) = ([0.0f64; 3], [0.0f64; 3]);
     let mut non_finite = 0;
     let key = Rng::pixel_key(settings.seed, pixel);
-    for s in 0..settings.spp {
+    let camera_sample = |s: u32| {
         let mut rng = Rng::for_pixel_sample(key, s as u64);
-        let ray = cam.generate_ray(x, y, &mut rng);
+        (cam.generate_ray(x, y, &mut rng), rng)
+    };
+    // One sample ahead: the next camera ray's hashing, division and square root run while
+    // this sample traces, instead of ahead of its traversal on the critical path.
+    let mut next = (settings.spp > 0).then(|| camera_sample(0));
+    for s in 0..settings.spp {
+        let (ray, mut rng) = next.take().expect("drawn one sample ahead");
+        if s + 1 < settings.spp {
+            next = Some(camera_sample(s + 1));
+        }
         let mut v = direct.li(&ray, &mut rng);
         if !v.is_finite() {
             // Counted and reported; a correct estimator never gets here (tests assert 0).
