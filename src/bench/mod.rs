@@ -103,17 +103,35 @@ fn throughput(
     threads: usize,
     repeat: u32,
 ) -> f64 {
-    let settings = RenderSettings {
-        spp,
-        seed: 1,
-        threads: Some(threads),
-        progress: false,
-    };
-    let best = (0..repeat.max(1))
-        .map(|_| render(scene, strategy, &settings).seconds)
-        .fold(f64::INFINITY, f64::min);
+    throughputs(scene, strategy, spp, &[threads], repeat)[0]
+}
+
+/// Samples per second at each thread count, best of `repeat`. The thread counts take turns
+/// within each repetition, so a slow spell of a shared machine (minutes long on this VM) hits
+/// all of them alike instead of the one measured during it: their ratio is the scaling.
+fn throughputs(
+    scene: &crate::scene::Scene,
+    strategy: Strategy,
+    spp: u32,
+    threads: &[usize],
+    repeat: u32,
+) -> Vec<f64> {
+    let mut best = vec![f64::INFINITY; threads.len()];
+    for _ in 0..repeat.max(1) {
+        for (b, &t) in best.iter_mut().zip(threads) {
+            let settings = RenderSettings {
+                spp,
+                seed: 1,
+                threads: Some(t),
+                progress: false,
+            };
+            *b = b.min(render(scene, strategy, &settings).seconds);
+        }
+    }
     let (w, h) = (scene.camera.width, scene.camera.height);
-    w as f64 * h as f64 * spp as f64 / best
+    best.iter()
+        .map(|b| w as f64 * h as f64 * spp as f64 / b)
+        .collect()
 }
 
 /// Nanoseconds per emitter choice (one uniform number in, emitter and pmf out), best of 3
@@ -170,8 +188,8 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         let name = path.display().to_string();
         for strategy in bench_strategies() {
             let mut by_threads = Vec::new();
-            for &threads in &a.threads {
-                let sps = throughput(&scene, strategy, a.spp, threads, a.repeat);
+            let all = throughputs(&scene, strategy, a.spp, &a.threads, a.repeat);
+            for (&threads, &sps) in a.threads.iter().zip(&all) {
                 by_threads.push((threads, sps));
                 println!(
                     "  {:<34} {:<26} {:>7} {:>12.2}",
