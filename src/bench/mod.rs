@@ -283,6 +283,9 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         "per-sample cost as the scene grows ({} threads, power MIS):",
         max_threads
     );
+    // 64x64 pixels at this spp: 262k samples per timed render, long enough (tens of ms) that
+    // one scheduler hiccup does not decide a size's cost; the scene builds dominate anyway.
+    const SWEEP_SPP: u32 = 64;
     let mut tri_costs = Vec::new();
     for n in [1_000usize, 10_000, 100_000, 1_000_000] {
         if n > a.max_triangles {
@@ -290,7 +293,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         }
         let scene =
             crate::scene::Scene::build(scaling::tessellated(n)).map_err(|e| e.to_string())?;
-        let sps = throughput(&scene, mis, 16, max_threads, a.repeat);
+        let sps = throughput(&scene, mis, SWEEP_SPP, max_threads, a.repeat);
         let tris = scene.accel.primitive_count() as u64;
         println!("  {:>9} triangles: {:>8.1} ns/sample", tris, 1e9 / sps);
         tri_costs.push(1e9 / sps);
@@ -318,7 +321,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             }
             let scene =
                 crate::scene::Scene::build(scaling::many_lights(n)).map_err(|e| e.to_string())?;
-            let sps = throughput(&scene, s, 16, max_threads, a.repeat);
+            let sps = throughput(&scene, s, SWEEP_SPP, max_threads, a.repeat);
             println!(
                 "  {:>9} emitters ({}): {:>8.1} ns/sample",
                 n,
