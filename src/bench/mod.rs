@@ -188,10 +188,9 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         let scene = open_scene(path, &[("res".into(), a.res.to_string())])?;
         let name = path.display().to_string();
         for strategy in bench_strategies() {
-            let mut by_threads = Vec::new();
             let all = throughputs(&scene, strategy, a.spp, &a.threads, a.repeat);
-            for (&threads, &sps) in a.threads.iter().zip(&all) {
-                by_threads.push((threads, sps));
+            let by_threads: Vec<(usize, f64)> = a.threads.iter().copied().zip(all).collect();
+            for &(threads, sps) in &by_threads {
                 println!(
                     "  {:<34} {:<26} {:>7} {:>12.2}",
                     name,

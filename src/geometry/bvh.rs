@@ -52,13 +52,17 @@ struct BoxRay {
     tmin: F8,
 }
 
+/// The slab test's 1 / d. 1/0 = inf would meet a zero (b - o) and give NaN; f32::MAX keeps
+/// every product ordered (0 stays 0, anything else overflows to the right infinity).
+#[inline(always)]
+fn slab_inv(d: Vec3) -> Vec3A {
+    (Vec3A::ONE / Vec3A::from(d)).clamp(Vec3A::splat(-f32::MAX), Vec3A::splat(f32::MAX))
+}
+
 impl BoxRay {
     #[inline(always)]
     fn new(o: Vec3, d: Vec3, tmin: f32) -> Self {
-        // 1/0 = inf would meet a zero (b - o) and give NaN; f32::MAX keeps every product
-        // ordered (0 stays 0, anything else overflows to the right infinity).
-        let inv = Vec3::from(Vec3A::ONE / Vec3A::from(d));
-        let inv = inv.clamp(Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX));
+        let inv = slab_inv(d);
         let neg = |x: f32| x.is_sign_negative() as usize;
         let near = [neg(inv.x), 2 + neg(inv.y), 4 + neg(inv.z)];
         BoxRay {
@@ -128,8 +132,7 @@ impl WideBvh {
     /// for structures most rays miss (the emitter pre-test's).
     #[inline(always)]
     pub fn may_enter(&self, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> bool {
-        let inv =
-            (Vec3A::ONE / Vec3A::from(d)).clamp(Vec3A::splat(-f32::MAX), Vec3A::splat(f32::MAX));
+        let inv = slab_inv(d);
         let o = Vec3A::from(o);
         let (t0, t1) = ((self.bounds.0 - o) * inv, (self.bounds.1 - o) * inv);
         // No NaN can arise (finite times finite), so min and max pick the plane the node test

@@ -7,14 +7,9 @@ use crate::emitter::LightSampling;
 use crate::geometry::Hit;
 use crate::rng::Rng;
 use crate::sampling::warps::square_to_uniform_sphere;
-use std::path::Path;
 
 fn open(rel: &str) -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(rel);
-    let desc = super::load_scene(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
-    Scene::build(desc).unwrap_or_else(|e| panic!("{e}"))
+    Scene::build(super::bundled_tests::load(rel)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn same(a: &Option<Hit>, b: &Option<Hit>) -> bool {

@@ -340,6 +340,7 @@ impl Scene {
         }
     }
 
+    /// `bsdf_ray_hit` past the box reject: out of line, since few BSDF rays get here.
     #[inline(never)]
     fn bsdf_ray_hit_traced(&self, ray: &Ray, emitter_skip: u32) -> Option<Hit> {
         if let Some(e) = &self.emitter_accel {
