@@ -135,6 +135,8 @@ pub struct PooledMean {
     pub seeds: usize,
     pub mean: [f64; 3],
     pub var: [f64; 3],
+    /// The largest `Row::top_share` among the pooled rows, where recorded.
+    pub top_share: Option<f64>,
 }
 
 /// Pools each strategy's rows at its highest spp with at least two samples per pixel (the
@@ -168,6 +170,7 @@ pub fn pooled_means(rows: &[Row], order: &[(String, String)]) -> Vec<PooledMean>
                 seeds: rs.len(),
                 mean,
                 var,
+                top_share: rs.iter().filter_map(|r| r.top_share).reduce(f64::max),
             })
         })
         .collect()
@@ -260,6 +263,7 @@ mod tests {
             seeds: 1,
             mean: [m; 3],
             var: [1e-6; 3],
+            top_share: None,
         };
         let same = mean_difference(&pm(1.0), &pm(1.001), 0.01);
         assert!(same.iter().all(|d| d.consistent));

@@ -63,7 +63,9 @@ pub struct Row {
     /// ... its largest sample, ...
     #[serde(default)]
     pub max_sample: Option<f64>,
-    /// ... and the share of its squared error (x - r)^2 carried by its largest 0.1 %.
+    /// ... and the share of its squared error (x - r)^2 carried by its largest 0.1 %. Image
+    /// rows: the share of the squared error against the reference held by the worst 0.1 % of
+    /// pixels (empty in rows written before it was recorded).
     #[serde(default)]
     pub top_share: Option<f64>,
 }

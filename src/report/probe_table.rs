@@ -53,7 +53,7 @@ fn verdict(r: &TableRow, zc: f64) -> &'static str {
         NON_FINITE
     } else if r.z.abs() < zc {
         OK
-    } else if r.z < 0.0 && (r.blind.is_some() || r.top_share > 0.5) {
+    } else if r.z < 0.0 && (r.blind.is_some() || r.top_share > crate::stats::TAIL_SHARE) {
         TAIL
     } else {
         BIASED

@@ -13,3 +13,21 @@ pub use domain::{Disk, Domain, Sphere, Triangle, UnitSquare};
 pub use integrate::Integration;
 pub use ttest::{one_sample, one_sample_welford, sidak, welch, Group, TTest};
 pub use welford::Welford;
+
+/// A `top_share` above this marks an error held by outliers: a mean that is too low then
+/// most likely missed a rare large value rather than being biased.
+pub const TAIL_SHARE: f64 = 0.5;
+
+/// Share of the sum of non-negative terms (squared errors) carried by its largest ceil(0.1 %):
+/// near 1 when a handful of outliers (fireflies, a tiny bright light) hold the error, which
+/// is when a sample variance underestimates the true one. NaN if all terms are 0.
+pub fn top_share(mut e: Vec<f64>) -> f64 {
+    let total: f64 = e.iter().sum();
+    if !(total > 0.0) {
+        return f64::NAN;
+    }
+    let k = e.len().div_ceil(1000).max(1);
+    let i = e.len() - k;
+    e.select_nth_unstable_by(i, f64::total_cmp);
+    e[i..].iter().sum::<f64>() / total
+}

@@ -84,15 +84,7 @@ pub fn batch_mse(x: &[f64], spp: usize, reference: f64) -> f64 {
 
 /// Share of sum (x - r)^2 carried by the largest ceil(0.1 %) of the terms; NaN if all are 0.
 pub fn top_share(x: &[f64], reference: f64) -> f64 {
-    let mut e: Vec<f64> = x.iter().map(|v| (v - reference).powi(2)).collect();
-    let total: f64 = e.iter().sum();
-    if !(total > 0.0) {
-        return f64::NAN;
-    }
-    let k = x.len().div_ceil(1000).max(1);
-    let i = e.len() - k;
-    e.select_nth_unstable_by(i, f64::total_cmp);
-    e[i..].iter().sum::<f64>() / total
+    crate::stats::top_share(x.iter().map(|v| (v - reference).powi(2)).collect())
 }
 
 pub fn stream(x: &[f64], non_finite: u64, reference: f64) -> Stream {
