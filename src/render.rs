@@ -36,6 +36,49 @@ impl RenderOutput {
     }
 }
 
+/// A pixel's running sums of x - K in f64, K its first sample ("shifted data"): as stable as
+/// Welford's update for values near K, exact 0 variance for constant pixels, and no division
+/// per sample.
+#[derive(Default)]
+struct PixelStats {
+    n: u32,
+    shift: [f64; 3],
+    s1: [f64; 3],
+    s2: [f64; 3],
+}
+
+impl PixelStats {
+    #[inline]
+    fn push(&mut self, v: glam::Vec3) {
+        for c in 0..3 {
+            let x = v[c] as f64;
+            if self.n == 0 {
+                self.shift[c] = x;
+            }
+            let d = x - self.shift[c];
+            self.s1[c] += d;
+            self.s2[c] += d * d;
+        }
+        self.n += 1;
+    }
+
+    /// Sample mean and variance of the mean (sample variance / n).
+    fn finish(&self) -> ([f64; 3], [f64; 3]) {
+        let n = self.n as f64;
+        let (mut mean, mut var_of_mean) = ([0.0; 3], [0.0; 3]);
+        for c in 0..3 {
+            if self.n > 0 {
+                mean[c] = self.shift[c] + self.s1[c] / n;
+            }
+            if self.n > 1 {
+                let m2 = (self.s2[c] - self.s1[c] * self.s1[c] / n).max(0.0);
+                var_of_mean[c] = m2 / (n - 1.0) / n;
+            }
+        }
+        (mean, var_of_mean)
+    }
+}
+
 struct PixelResult {
     mean: [f64; 3],
     var_of_mean: [f64; 3],
@@ -45,8 +88,7 @@ struct PixelResult {
 fn render_pixel(direct: &Direct, x: u32, y: u32, settings: &RenderSettings) -> PixelResult {
     let cam = &direct.scene.camera;
     let pixel = y as u64 * cam.width as u64 + x as u64;
-    // Welford's update in f64: stable for millions of samples of very different size.
-    let (mut mean, mut m2) = ([0.0f64; 3], [0.0f64; 3]);
+    let mut stats = PixelStats::default();
     let mut non_finite = 0;
     let key = Rng::pixel_key(settings.seed, pixel);
     let camera_sample = |s: u32| {
@@ -67,20 +109,9 @@ fn render_pixel(direct: &Direct, x: u32, y: u32, settings: &RenderSettings) -> P
             non_finite += 1;
             v = glam::Vec3::ZERO;
         }
-        let n = (s + 1) as f64;
-        for c in 0..3 {
-            let x = v[c] as f64;
-            let d = x - mean[c];
-            mean[c] += d / n;
-            m2[c] += d * (x - mean[c]);
-        }
+        stats.push(v);
     }
-    let n = settings.spp as f64;
-    let var_of_mean = if settings.spp > 1 {
-        m2.map(|m| m / (n - 1.0) / n)
-    } else {
-        [0.0; 3]
-    };
+    let (mean, var_of_mean) = stats.finish();
     PixelResult {
         mean,
         var_of_mean,
@@ -143,5 +174,49 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
         spp: settings.spp,
         seconds,
         non_finite_samples,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    /// Two-pass mean and variance of the mean in f64, the textbook definition.
+    fn two_pass(x: &[f64]) -> (f64, f64) {
+        let n = x.len() as f64;
+        let m = x.iter().sum::<f64>() / n;
+        let v = x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0);
+        (m, v / n)
+    }
+
+    #[test]
+    fn pixel_stats_match_two_pass_and_give_zero_for_constant_pixels() {
+        let mut rng = Rng::new(7, 3);
+        // Offset far from 0, a firefly, and a pixel whose first sample is the firefly.
+        let cases: Vec<Vec<f32>> = vec![
+            (0..256).map(|_| 1e3 + rng.next_f32()).collect(),
+            (0..256)
+                .map(|i| if i == 100 { 1e6 } else { rng.next_f32() })
+                .collect(),
+            (0..64)
+                .map(|i| if i == 0 { 1e6 } else { rng.next_f32() })
+                .collect(),
+        ];
+        for x in cases {
+            let mut st = PixelStats::default();
+            x.iter().for_each(|&v| st.push(Vec3::new(v, 2.0 * v, 0.5)));
+            let (mean, var) = st.finish();
+            let x64: Vec<f64> = x.iter().map(|&v| v as f64).collect();
+            let (m, v) = two_pass(&x64);
+            assert!((mean[0] - m).abs() <= 1e-12 * m.abs(), "{} {m}", mean[0]);
+            assert!((var[0] - v).abs() <= 1e-9 * v, "{} {v}", var[0]);
+            assert!((var[1] - 4.0 * v).abs() <= 1e-9 * v);
+            assert_eq!((mean[2], var[2]), (0.5, 0.0), "constant channel");
+        }
+        let mut one = PixelStats::default();
+        one.push(Vec3::splat(3.0));
+        assert_eq!(one.finish(), ([3.0; 3], [0.0; 3]));
+        assert_eq!(PixelStats::default().finish(), ([0.0; 3], [0.0; 3]));
     }
 }

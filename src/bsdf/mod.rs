@@ -94,6 +94,20 @@ impl Material {
         }
     }
 
+    /// `(eval, pdf)` with the work they share done once.
+    #[inline]
+    pub fn eval_pdf(&self, wi: Vec3, wo: Vec3) -> (Rgb, f32) {
+        let (wi, wo) = self.orient(wi, wo);
+        match &self.kind {
+            BsdfKind::Diffuse(b) => (b.eval(wi, wo), b.pdf(wi, wo)),
+            BsdfKind::RoughConductor(b) => b.eval_pdf(wi, wo),
+            BsdfKind::NoriMicrofacet(b) => (b.eval(wi, wo), b.pdf(wi, wo)),
+            BsdfKind::Conductor(_) | BsdfKind::Dielectric(_) | BsdfKind::Mirror(_) => {
+                (Rgb::ZERO, 0.0)
+            }
+        }
+    }
+
     /// `u1` picks a lobe, `u2` the direction within it: separate numbers for separate decisions.
     #[inline]
     pub fn sample(&self, wi: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {

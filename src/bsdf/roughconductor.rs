@@ -40,32 +40,38 @@ impl RoughConductor {
 
     #[inline]
     pub fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            return Rgb::ZERO;
-        }
-        let h = Self::half(wi, wo);
-        let d = self.mf.d(h);
-        if d == 0.0 {
-            return Rgb::ZERO;
-        }
-        let g = self.mf.g(wi, wo, h);
-        self.fresnel(wi.dot(h)) * (d * g / (4.0 * wi.z))
+        self.eval_pdf(wi, wo).0
     }
 
     #[inline]
     pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+        self.eval_pdf(wi, wo).1
+    }
+
+    /// `eval` and `pdf` together: both need the half vector, D and G1(wi), and a light
+    /// sample under MIS or a BSDF sample's weight needs both (one exp, one f64 normalise).
+    #[inline]
+    pub fn eval_pdf(&self, wi: Vec3, wo: Vec3) -> (Rgb, f32) {
         if wi.z <= 0.0 || wo.z <= 0.0 {
-            return 0.0;
+            return (Rgb::ZERO, 0.0);
         }
         let h = Self::half(wi, wo);
-        if self.sample_visible {
+        let d = self.mf.d(h);
+        let g1_i = self.mf.g1(wi, h);
+        let pdf = if self.sample_visible {
             // G1 (wi.h) D / cos_i over the reflection Jacobian 4 (wo.h): the dot products are
             // equal in exact arithmetic, but f32 unit vectors are not exactly unit, and at
             // grazing angles their ratio drifts from 1 by ~1e-4. Cancel them symbolically.
-            self.mf.g1(wi, h) * self.mf.d(h) / (4.0 * wi.z)
+            g1_i * d / (4.0 * wi.z)
         } else {
             self.mf.pdf_all(h) / (4.0 * wo.dot(h))
+        };
+        if d == 0.0 {
+            return (Rgb::ZERO, pdf);
         }
+        // Separable Smith G, as `Microfacet::g`.
+        let g = g1_i * self.mf.g1(wo, h);
+        (self.fresnel(wi.dot(h)) * (d * g / (4.0 * wi.z)), pdf)
     }
 
     #[inline]
@@ -86,11 +92,11 @@ impl RoughConductor {
         if wo.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf(wi, wo);
+        let (f, pdf) = self.eval_pdf(wi, wo);
         if !(pdf > 0.0) {
             return None;
         }
-        let weight = self.eval(wi, wo) / pdf;
+        let weight = f / pdf;
         Some(BsdfSample {
             wo,
             weight,

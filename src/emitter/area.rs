@@ -108,9 +108,13 @@ impl AreaLight {
     ) -> Option<LightSample> {
         let sp = match &shapes[self.shape as usize].kind {
             ShapeKind::Sphere(s) => {
-                if let (LightSampling::SolidAngle, Some(one_minus)) =
-                    (mode, cone_one_minus_cos_max(s, ref_p))
-                {
+                // The cone is only worked out for solid-angle sampling (a tuple pattern would
+                // evaluate it, square root and divisions included, for area sampling too).
+                let cone = match mode {
+                    LightSampling::SolidAngle => cone_one_minus_cos_max(s, ref_p),
+                    LightSampling::Area => None,
+                };
+                if let Some(one_minus) = cone {
                     let axis = (s.center - ref_p).normalize();
                     let wi =
                         Frame::from_normal(axis).to_world(square_to_uniform_cone_1m(u, one_minus));

@@ -187,7 +187,7 @@ impl<'a> Direct<'a> {
             return Rgb::ZERO;
         };
         let wo = sh.frame.to_local(ls.wi);
-        let f = sh.mat.eval(sh.wi, wo);
+        let (f, pdf) = sh.mat.eval_pdf(sh.wi, wo);
         if f == Rgb::ZERO || ls.li == Rgb::ZERO {
             return Rgb::ZERO;
         }
@@ -195,7 +195,7 @@ impl<'a> Direct<'a> {
             return Rgb::ZERO;
         }
         let p_light = pmf * ls.pdf;
-        let p_bsdf = if ls.delta { 0.0 } else { sh.mat.pdf(sh.wi, wo) };
+        let p_bsdf = if ls.delta { 0.0 } else { pdf };
         let w = weight(p_light, p_bsdf);
         f * ls.li * (w / p_light)
     }
