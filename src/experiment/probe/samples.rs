@@ -63,7 +63,7 @@ mod tests {
     use crate::render::{render, RenderSettings};
     use crate::scene::{fixtures, Scene};
 
-    /// Same samples as the renderer: the means agree to rounding (Welford vs a plain sum).
+    /// Same samples as the renderer: the means agree to rounding (Welford vs shifted sums).
     #[test]
     fn extreme_samples_reproduce_the_renderer() {
         let scene = Scene::build(fixtures::furnace(0.5, true, 3)).unwrap();
