@@ -69,7 +69,7 @@ impl RoughConductor {
         if d == 0.0 {
             return (Rgb::ZERO, pdf);
         }
-        // Separable Smith G, as `Microfacet::g`.
+        // Separable Smith shadowing-masking, as Mitsuba's microfacet plugins.
         let g = g1_i * self.mf.g1(wo, h);
         (self.fresnel(wi.dot(h)) * (d * g / (4.0 * wi.z)), pdf)
     }

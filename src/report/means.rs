@@ -16,53 +16,49 @@ pub struct Comparison {
     pub a: String,
     pub b: String,
     pub diffs: Vec<MeanDiff>,
-    /// For a failed test: the lower image's name and `top_share`, if that share says its
-    /// error sits in a few pixels (see `MeanVerdict::Tail`).
-    pub low_tail: Option<(String, f64)>,
+    /// `a`'s and `b`'s `top_share`, where above `TAIL_SHARE` (see `MeanVerdict::Tail`).
+    pub tail_share: [Option<f64>; 2],
 }
 
 /// What one channel's test says.
 #[derive(Debug, PartialEq)]
 pub enum MeanVerdict {
     Consistent,
-    /// Failed, but the lower image holds most of its squared error in 0.1 % of its pixels:
-    /// a rare large value (a tiny bright light seen directly, or through a near-specular
-    /// reflection) went unsampled there, its variance image underestimates the true variance
-    /// and the z-test's normal approximation does not hold. Not evidence of bias at this spp.
-    Tail,
+    /// Failed, but the lower image holds this share of its squared error in 0.1 % of its
+    /// pixels: a rare large value (a tiny bright light seen directly, or through a
+    /// near-specular reflection) went unsampled there, its variance image underestimates the
+    /// true variance and the z-test's normal approximation does not hold. Not evidence of bias
+    /// at this spp. (A tail only makes a mean too low, never too high.)
+    Tail(f64),
     Different,
 }
 
 impl Comparison {
-    pub fn verdict(&self, d: &MeanDiff) -> MeanVerdict {
-        if d.consistent {
-            MeanVerdict::Consistent
-        } else if self.low_tail.as_ref().is_some_and(|(low, _)| {
-            // The tail explains a mean that is too low, never one that is too high.
-            (d.diff < 0.0 && *low == self.a) || (d.diff > 0.0 && *low == self.b)
-        }) {
-            MeanVerdict::Tail
+    /// The image that is lower in this channel, and its tail share.
+    fn low(&self, d: &MeanDiff) -> (&str, Option<f64>) {
+        if d.diff < 0.0 {
+            (&self.a, self.tail_share[0])
         } else {
-            MeanVerdict::Different
+            (&self.b, self.tail_share[1])
+        }
+    }
+
+    pub fn verdict(&self, d: &MeanDiff) -> MeanVerdict {
+        match self.low(d).1 {
+            _ if d.consistent => MeanVerdict::Consistent,
+            Some(share) => MeanVerdict::Tail(share),
+            None => MeanVerdict::Different,
         }
     }
 }
 
-/// The comparison of `a` and `b`; `low_tail` names whichever of them has a heavy tail.
 fn compare(a: &PooledMean, b: &PooledMean, alpha: f64) -> Comparison {
-    let tail = |p: &PooledMean| {
-        p.top_share
-            .filter(|&s| s > TAIL_SHARE)
-            .map(|s| (p.name.clone(), s))
-    };
-    let diffs = mean_difference(a, b, alpha);
-    // Channels of one comparison move together; the lower image is the one below on average.
-    let below: f64 = diffs.iter().map(|d| d.diff).sum();
+    let tail = |p: &PooledMean| p.top_share.filter(|&s| s > TAIL_SHARE);
     Comparison {
         a: a.name.clone(),
         b: b.name.clone(),
-        low_tail: if below < 0.0 { tail(a) } else { tail(b) },
-        diffs,
+        diffs: mean_difference(a, b, alpha),
+        tail_share: [tail(a), tail(b)],
     }
 }
 
@@ -126,13 +122,14 @@ pub fn mean_check_lines(o: &Outcome) -> Vec<String> {
                 x.diff,
                 x.half_width_95,
                 x.z,
-                match (cmp.verdict(x), &cmp.low_tail) {
-                    (MeanVerdict::Consistent, _) => "consistent (same expectation)".to_string(),
-                    (MeanVerdict::Tail, Some((low, share))) => format!(
-                        "too low at family-wise alpha {MEAN_ALPHA}, but {:.0} % of {low}'s squared error sits in 0.1 % of its pixels: a rare bright value went unsampled and its variance is underestimated, so this is not evidence of bias at this spp (render more to decide)",
-                        100.0 * share
+                match cmp.verdict(x) {
+                    MeanVerdict::Consistent => "consistent (same expectation)".to_string(),
+                    MeanVerdict::Tail(share) => format!(
+                        "too low at family-wise alpha {MEAN_ALPHA}, but {:.0} % of {}'s squared error sits in 0.1 % of its pixels: a rare bright value went unsampled and its variance is underestimated, so this is not evidence of bias at this spp (render more to decide)",
+                        100.0 * share,
+                        cmp.low(x).0
                     ),
-                    _ => format!("DIFFERENT at family-wise alpha {MEAN_ALPHA} (per test {alpha:.1e}): one of them is biased"),
+                    MeanVerdict::Different => format!("DIFFERENT at family-wise alpha {MEAN_ALPHA} (per test {alpha:.1e}): one of them is biased"),
                 }
             ));
         }
@@ -194,10 +191,10 @@ mod tests {
         let tail = pm("MIS", 0.98, Some(0.92));
         assert!(verdicts(&tail, &reference)
             .iter()
-            .all(|v| *v == MeanVerdict::Tail));
+            .all(|v| matches!(v, MeanVerdict::Tail(s) if *s == 0.92)));
         assert!(verdicts(&reference, &tail)
             .iter()
-            .all(|v| *v == MeanVerdict::Tail));
+            .all(|v| matches!(v, MeanVerdict::Tail(s) if *s == 0.92)));
         // Spread error, or no share recorded: a bias.
         for share in [Some(0.3), None] {
             let spread = pm("MIS", 0.98, share);

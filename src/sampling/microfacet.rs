@@ -92,12 +92,6 @@ impl Microfacet {
         1.0 / (1.0 + self.lambda(w))
     }
 
-    /// Separable Smith shadowing-masking (as Mitsuba's microfacet plugins).
-    #[inline]
-    pub fn g(&self, wi: Vec3, wo: Vec3, m: Vec3) -> f32 {
-        self.g1(wi, m) * self.g1(wo, m)
-    }
-
     /// A normal with density D(m) cos(theta_m).
     #[inline]
     pub fn sample_all(&self, u: Vec2) -> Vec3 {
