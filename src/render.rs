@@ -3,7 +3,7 @@
 
 use crate::film::Image;
 use crate::integrator::{Direct, Strategy};
-use crate::rng::Rng;
+use crate::rng::{Rng, RngLanes, LANES};
 use crate::scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -91,25 +91,22 @@ fn render_pixel(direct: &Direct, x: u32, y: u32, settings: &RenderSettings) -> P
     let mut stats = PixelStats::default();
     let mut non_finite = 0;
     let key = Rng::pixel_key(settings.seed, pixel);
-    let camera_sample = |s: u32| {
-        let mut rng = Rng::for_pixel_sample(key, s as u64);
-        (cam.generate_ray(x, y, &mut rng), rng)
-    };
-    // One sample ahead: the next camera ray's hashing, division and square root run while
-    // this sample traces, instead of ahead of its traversal on the critical path.
-    let mut next = (settings.spp > 0).then(|| camera_sample(0));
-    for s in 0..settings.spp {
-        let (ray, mut rng) = next.take().expect("drawn one sample ahead");
-        if s + 1 < settings.spp {
-            next = Some(camera_sample(s + 1));
+    // Samples start LANES at a time: their generators and camera rays are computed side by
+    // side in vector registers, each bitwise what `for_pixel_sample` and `generate_ray` give
+    // (lanes past spp are computed and dropped). Then each is traced and shaded on its own.
+    for s0 in (0..settings.spp).step_by(LANES) {
+        let mut lanes = RngLanes::for_pixel_samples(key, s0 as u64);
+        let rays = cam.generate_rays(x, y, &mut lanes);
+        let n = (settings.spp - s0).min(LANES as u32) as usize;
+        for (i, ray) in rays.iter().enumerate().take(n) {
+            let mut v = direct.li(ray, &mut lanes.lane(i));
+            if !v.is_finite() {
+                // Counted and reported; a correct estimator never gets here (tests assert 0).
+                non_finite += 1;
+                v = glam::Vec3::ZERO;
+            }
+            stats.push(v);
         }
-        let mut v = direct.li(&ray, &mut rng);
-        if !v.is_finite() {
-            // Counted and reported; a correct estimator never gets here (tests assert 0).
-            non_finite += 1;
-            v = glam::Vec3::ZERO;
-        }
-        stats.push(v);
     }
     let (mean, var_of_mean) = stats.finish();
     PixelResult {
@@ -218,5 +215,52 @@ mod tests {
         one.push(Vec3::splat(3.0));
         assert_eq!(one.finish(), ([3.0; 3], [0.0; 3]));
         assert_eq!(PixelStats::default().finish(), ([0.0; 3], [0.0; 3]));
+    }
+
+    /// The render loop starts samples eight at a time; every pixel must still be exactly the
+    /// per-sample definition: generator `for_sample(seed, pixel, s)`, `generate_ray`, `li`.
+    #[test]
+    fn lane_started_samples_are_bitwise_the_per_sample_definition() {
+        for (rel, filter) in [
+            ("cbox/cbox.xml", None),
+            (
+                "veach-mis/veach-mis.xml",
+                Some(crate::scene::desc::FilterDesc::Tent { radius: 1.0 }),
+            ),
+        ] {
+            let mut desc = crate::scene::bundled_tests::load(rel);
+            (desc.film.width, desc.film.height) = (12, 9);
+            if let Some(f) = filter {
+                desc.film.filter = f;
+            }
+            let scene = Scene::build(desc).unwrap();
+            let strategy = crate::integrator::Strategy::combinations()
+                .into_iter()
+                .find(|s| s.kind == crate::scene::desc::StrategyKind::Mis)
+                .unwrap();
+            let settings = RenderSettings {
+                spp: 11,
+                seed: 5,
+                threads: Some(1),
+                progress: false,
+            };
+            let out = render(&scene, strategy, &settings);
+            let direct = Direct::new(&scene, strategy);
+            let cam = &scene.camera;
+            for y in 0..cam.height {
+                for x in 0..cam.width {
+                    let pixel = y as u64 * cam.width as u64 + x as u64;
+                    let mut st = PixelStats::default();
+                    for s in 0..settings.spp {
+                        let mut rng = Rng::for_sample(settings.seed, pixel, s as u64);
+                        let ray = cam.generate_ray(x, y, &mut rng);
+                        st.push(direct.li(&ray, &mut rng));
+                    }
+                    let (mean, var) = st.finish();
+                    assert_eq!(out.mean.get(x, y), mean, "{rel} pixel ({x}, {y})");
+                    assert_eq!(out.variance.get(x, y), var, "{rel} pixel ({x}, {y})");
+                }
+            }
+        }
     }
 }

@@ -11,7 +11,7 @@ fn scene_path(rel: &str) -> PathBuf {
         .join(rel)
 }
 
-pub(super) fn load(rel: &str) -> SceneDesc {
+pub(crate) fn load(rel: &str) -> SceneDesc {
     load_scene(&scene_path(rel), &[]).unwrap_or_else(|e| panic!("{e}"))
 }
 

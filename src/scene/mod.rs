@@ -46,4 +46,4 @@ pub use loader::{load_scene, load_scene_str, Dialect};
 #[cfg(test)]
 mod bsdf_ray_tests;
 #[cfg(test)]
-mod bundled_tests;
+pub(crate) mod bundled_tests;
