@@ -99,12 +99,10 @@ impl Camera {
             skip: NO_SKIP,
         }
     }
-}
 
-impl Camera {
     /// `generate_ray` for `LANES` samples of pixel (px, py), lane i drawing from lane i of
     /// `rng`: the same IEEE operations in the same order (glam's `transform_vector3` is
-    /// x*dx + y*dy + z*dz, `length` is (x*x + y*y) + z*z), so every ray is bitwise the one
+    /// x*dx + y*dy + z*1, `length` is (x*x + y*y) + z*z), so every ray is bitwise the one
     /// `generate_ray` gives, computed eight at a time.
     #[inline]
     pub fn generate_rays(&self, px: u32, py: u32, rng: &mut RngLanes) -> [Ray; LANES] {
@@ -137,7 +135,7 @@ impl Camera {
             let dx = (1.0 - 2.0 * ((cx + ox[i]) / w)) * self.tan_half.x;
             let dy = (1.0 - 2.0 * ((cy + oy[i]) / h)) * self.tan_half.y;
             for c in 0..3 {
-                d[c][i] = ax[c] * dx + ay[c] * dy + az[c] * 1.0;
+                d[c][i] = ax[c] * dx + ay[c] * dy + az[c];
             }
             len[i] = (d[0][i] * d[0][i] + d[1][i] * d[1][i] + d[2][i] * d[2][i]).sqrt();
         }

@@ -85,9 +85,9 @@ impl Rng {
 /// Samples drawn side by side: camera samples are started this many at a time.
 pub const LANES: usize = 8;
 
-/// `LANES` per-sample generators stepped together, lane i being `for_pixel_sample(key, s0 + i)`
-/// exactly. Plain loops over arrays, which the compiler turns into vector instructions: the
-/// seeding (three 64-bit multiplications per mix) and the camera's draws cost an eighth.
+/// `LANES` per-sample generators stepped together, lane i being `for_pixel_sample(key, s0 + i)`.
+/// Plain loops over arrays, which the compiler turns into vector instructions: the seeding
+/// (64-bit multiplications) and the camera's draws cost about an eighth.
 pub struct RngLanes {
     state: [u64; LANES],
     inc: [u64; LANES],
@@ -99,14 +99,9 @@ impl RngLanes {
         let mut state = [0; LANES];
         let mut inc = [0; LANES];
         for i in 0..LANES {
-            // `Rng::new(key, stream)` unrolled: its two warm-up steps from state 0 leave
-            // (inc + key) * M + inc.
-            let key = mix64(pixel_key ^ (s0 + i as u64));
-            inc[i] = (mix64(key ^ 0x5851_F42D_4C95_7F2D) << 1) | 1;
-            state[i] = inc[i]
-                .wrapping_add(key)
-                .wrapping_mul(PCG_MULT)
-                .wrapping_add(inc[i]);
+            // Inlined, the warm-up steps' discarded outputs drop out and the rest vectorises.
+            let r = Rng::for_pixel_sample(pixel_key, s0 + i as u64);
+            (state[i], inc[i]) = (r.state, r.inc);
         }
         RngLanes { state, inc }
     }
