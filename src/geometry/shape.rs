@@ -65,6 +65,19 @@ impl Mesh {
         }
     }
 
+    /// The point at barycentrics (b1, b2) of a triangle's vertices.
+    #[inline(always)]
+    pub fn interpolate([a, v1, v2]: [Vec3; 3], b: Vec2) -> Vec3 {
+        let b0 = 1.0 - b.x - b.y;
+        a * b0 + v1 * b.x + v2 * b.y
+    }
+
+    /// A triangle's unit face normal and error scale (see `face`).
+    #[inline(always)]
+    pub fn face(&self, tri: usize) -> (Vec3, Vec3) {
+        self.face[tri]
+    }
+
     #[inline]
     pub fn vertices(&self, tri: usize) -> [Vec3; 3] {
         let [a, b, c] = self.indices[tri];
@@ -85,31 +98,39 @@ impl Mesh {
     /// rather than to the ray's length.
     #[inline]
     pub fn surface_point(&self, tri: usize, b: Vec2, shape: u32) -> SurfacePoint {
-        let [a, v1, v2] = self.vertices(tri);
-        let b0 = 1.0 - b.x - b.y;
-        let p = a * b0 + v1 * b.x + v2 * b.y;
+        let p = Mesh::interpolate(self.vertices(tri), b);
         let (ng, err_scale) = self.face[tri];
-        let mut ns = ng;
-        let mut ngo = ng;
-        if let Some(normals) = &self.normals {
-            let [i0, i1, i2] = self.indices[tri];
-            let n =
-                normals[i0 as usize] * b0 + normals[i1 as usize] * b.x + normals[i2 as usize] * b.y;
-            // Degenerate (zero or opposing) vertex normals fall back to the face normal.
-            if let Some(n) = n.try_normalize() {
-                ns = n;
-                if ng.dot(ns) < 0.0 {
-                    ngo = -ng;
-                }
-            }
-        }
+        let (ng, ns) = match self.vertex_normals(tri) {
+            Some(n) => Mesh::shading_normals(ng, n, b),
+            None => (ng, ng),
+        };
         SurfacePoint {
             p,
-            ng: ngo,
+            ng,
             ns,
             shape,
             prim: tri as u32,
             err_scale,
+        }
+    }
+
+    /// The vertex normals of a triangle, if the mesh has them.
+    #[inline(always)]
+    pub fn vertex_normals(&self, tri: usize) -> Option<[Vec3; 3]> {
+        let normals = self.normals.as_ref()?;
+        Some(self.indices[tri].map(|i| normals[i as usize]))
+    }
+
+    /// (geometric, shading) normal at barycentrics `b` from the face normal `ng` and the
+    /// vertex normals: the interpolated normal, with `ng` turned to its side. Degenerate
+    /// (zero or opposing) vertex normals fall back to the face normal.
+    #[inline(always)]
+    pub fn shading_normals(ng: Vec3, [n0, n1, n2]: [Vec3; 3], b: Vec2) -> (Vec3, Vec3) {
+        let b0 = 1.0 - b.x - b.y;
+        match (n0 * b0 + n1 * b.x + n2 * b.y).try_normalize() {
+            Some(ns) if ng.dot(ns) < 0.0 => (-ng, ns),
+            Some(ns) => (ng, ns),
+            None => (ng, ng),
         }
     }
 

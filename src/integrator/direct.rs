@@ -9,6 +9,7 @@
 //! sampling only) are handled by that technique with weight 1 in every strategy, including
 //! the pure ones, so no strategy loses them and none counts them twice.
 
+use super::lanes::{lane_lights, LaneLight};
 use super::Strategy;
 use crate::bsdf::{BsdfSample, Material};
 use crate::emitter::{EmitterSelector, LightSample};
@@ -22,12 +23,14 @@ use glam::Vec3;
 pub struct Direct<'a> {
     pub scene: &'a Scene,
     pub strategy: Strategy,
-    selector: EmitterSelector,
+    pub(super) selector: EmitterSelector,
     has_delta_lights: bool,
+    /// Set when `li_lanes` covers the scene and strategy.
+    pub(super) lane_lights: Option<Vec<LaneLight<'a>>>,
 }
 
 #[inline]
-fn heuristic(h: Heuristic, a: f32, b: f32) -> f32 {
+pub(super) fn heuristic(h: Heuristic, a: f32, b: f32) -> f32 {
     let (a, b) = match h {
         Heuristic::Balance => (a, b),
         Heuristic::Power => (a * a, b * b),
@@ -49,21 +52,29 @@ struct Shading<'m> {
 
 impl<'a> Direct<'a> {
     pub fn new(scene: &'a Scene, strategy: Strategy) -> Self {
-        Direct {
+        let mut direct = Direct {
             scene,
             strategy,
             selector: EmitterSelector::new(&scene.emitters, strategy.selection),
             has_delta_lights: scene.emitters.iter().any(|e| e.is_delta()),
-        }
+            lane_lights: None,
+        };
+        direct.lane_lights = lane_lights(&direct);
+        direct
     }
 
     /// Radiance along a camera ray.
     pub fn li(&self, ray: &Ray, rng: &mut Rng) -> Rgb {
+        match self.scene.intersect(ray) {
+            Some(hit) => self.li_hit(ray, &hit.sp, rng),
+            None => Rgb::ZERO,
+        }
+    }
+
+    /// `li` given the camera ray's hit.
+    pub(super) fn li_hit(&self, ray: &Ray, sp: &SurfacePoint, rng: &mut Rng) -> Rgb {
         let scene = self.scene;
-        let Some(hit) = scene.intersect(ray) else {
-            return Rgb::ZERO;
-        };
-        let sp = hit.sp;
+        let sp = *sp;
         let mut l = Rgb::ZERO;
         if !self.strategy.hide_emitters {
             if let Some((_, e)) = scene.emitter_at(&sp) {
@@ -230,7 +241,22 @@ impl<'a> Direct<'a> {
         };
         let d = sh.frame.to_world(bs.wo);
         let (ray, emitter_skip) = scene.bsdf_ray(&sh.sp, d);
-        let Some(hit) = scene.bsdf_ray_hit(&ray, emitter_skip) else {
+        self.bsdf_arrive(sh.sp.p, &ray, emitter_skip, &bs, weight)
+    }
+
+    /// A BSDF sample's ray from `from` traced: the emission it reaches, weighted.
+    #[inline(always)]
+    pub(super) fn bsdf_arrive(
+        &self,
+        from: Vec3,
+        ray: &Ray,
+        emitter_skip: u32,
+        bs: &BsdfSample,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
+        let scene = self.scene;
+        let d = ray.d;
+        let Some(hit) = scene.bsdf_ray_hit(ray, emitter_skip) else {
             return Rgb::ZERO;
         };
         let Some((ei, e)) = scene.emitter_at(&hit.sp) else {
@@ -244,12 +270,7 @@ impl<'a> Direct<'a> {
             0.0
         } else {
             self.selector.pmf(ei)
-                * e.pdf(
-                    &scene.shapes,
-                    sh.sp.p,
-                    &hit.sp,
-                    self.strategy.light_sampling,
-                )
+                * e.pdf(&scene.shapes, from, &hit.sp, self.strategy.light_sampling)
         };
         let w = weight(bs.pdf, p_light);
         bs.weight * le * w

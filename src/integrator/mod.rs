@@ -1,6 +1,7 @@
 //! Direct-illumination estimators: light sampling, BSDF sampling and their MIS combinations.
 
 mod direct;
+mod lanes;
 mod strategy;
 
 pub use direct::Direct;

@@ -24,17 +24,21 @@ pub fn square_to_uniform_disk_pdf(p: Vec2) -> f32 {
 #[inline]
 pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
     let o = 2.0 * u - Vec2::ONE;
-    if o.x == 0.0 && o.y == 0.0 {
-        return Vec2::ZERO;
-    }
     // Both wedges need sin and cos of an angle in [-pi/4, pi/4] only: the second wedge's
-    // angle pi/2 - phi swaps them.
-    if o.x.abs() > o.y.abs() {
-        let (s, c) = sin_cos_quarter(PI / 4.0 * (o.y / o.x));
-        Vec2::new(o.x * c, o.x * s)
+    // angle pi/2 - phi swaps them. Written with selects rather than branches, so that a loop
+    // over eight samples (`integrator::lanes`) runs it in vector lanes.
+    let wide = o.x.abs() > o.y.abs();
+    let (num, den) = if wide { (o.y, o.x) } else { (o.x, o.y) };
+    let (s, c) = sin_cos_quarter(PI / 4.0 * (num / den));
+    let r = if wide {
+        Vec2::new(c, s)
     } else {
-        let (s, c) = sin_cos_quarter(PI / 4.0 * (o.x / o.y));
-        Vec2::new(o.y * s, o.y * c)
+        Vec2::new(s, c)
+    };
+    if o.x == 0.0 && o.y == 0.0 {
+        Vec2::ZERO
+    } else {
+        den * r
     }
 }
 

@@ -380,12 +380,18 @@ impl Scene {
         } else {
             offset_origin(ls.p, ls.ng, ls.err_scale, o - ls.p)
         };
+        Scene::shadow_ray_to(o, target, self.accel.skip_id(from))
+    }
+
+    /// The shadow ray from origin `o` to `target`, both already off their surfaces.
+    #[inline(always)]
+    pub fn shadow_ray_to(o: glam::Vec3, target: glam::Vec3, skip: u32) -> Ray {
         Ray {
             o,
             d: target - o,
             tmin: 0.0,
             tmax: 1.0 - 1e-4,
-            skip: self.accel.skip_id(from),
+            skip,
         }
     }
 
