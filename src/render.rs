@@ -91,21 +91,15 @@ fn render_pixel(direct: &Direct, x: u32, y: u32, settings: &RenderSettings) -> P
     let mut stats = PixelStats::default();
     let mut non_finite = 0;
     let key = Rng::pixel_key(settings.seed, pixel);
-    // Samples start LANES at a time: their generators and camera rays are computed side by
-    // side in vector registers, each bitwise what `for_pixel_sample` and `generate_ray` give
-    // (lanes past spp are computed and dropped). Then each is traced and shaded on its own.
+    // Samples go LANES at a time: their generators and camera rays are computed side by side
+    // in vector registers, and `li_lanes` shades them together where it covers the scene;
+    // each sample stays bitwise what `for_pixel_sample`, `generate_ray` and `li` give it
+    // (lanes past spp are dropped).
     for s0 in (0..settings.spp).step_by(LANES) {
         let mut lanes = RngLanes::for_pixel_samples(key, s0 as u64);
         let rays = cam.generate_rays(x, y, &mut lanes);
         let n = (settings.spp - s0).min(LANES as u32) as usize;
-        let values = if direct.has_lanes() {
-            direct.li_lanes(&rays, n, &mut lanes)
-        } else {
-            std::array::from_fn(|i| match i < n {
-                true => direct.li(&rays[i], &mut lanes.lane(i)),
-                false => glam::Vec3::ZERO,
-            })
-        };
+        let values = direct.li_lanes(&rays, n, &mut lanes);
         for mut v in values.into_iter().take(n) {
             if !v.is_finite() {
                 // Counted and reported; a correct estimator never gets here (tests assert 0).

@@ -22,7 +22,9 @@ pub struct AreaLight {
 }
 
 /// Direction and distance from `ref_p` to a light point, if the light faces `ref_p`
-/// (one-sided emission is decided by the shading normal, as Mitsuba and Nori do).
+/// (one-sided emission is decided by the shading normal, as Mitsuba and Nori do). Three
+/// scalar divisions rather than one `Vec3A` division: the loop over eight samples in
+/// `integrator::lanes` then runs this in vector lanes (a `Vec3A` keeps it scalar).
 #[inline]
 fn facing(ref_p: Vec3, sp: &SurfacePoint) -> Option<(Vec3, f32)> {
     let d = sp.p - ref_p;
@@ -30,8 +32,43 @@ fn facing(ref_p: Vec3, sp: &SurfacePoint) -> Option<(Vec3, f32)> {
     if !(dist > 0.0) {
         return None;
     }
-    let wi = crate::math::div3(d, dist);
+    let wi = Vec3::new(d.x / dist, d.y / dist, d.z / dist);
     (sp.ns.dot(-wi) > 0.0).then_some((wi, dist))
+}
+
+/// Uniform-by-area density, in solid angle, of a light point of a light of area `area` that
+/// faces the reference point along `wi` at distance `dist`.
+#[inline]
+pub(crate) fn area_pdf_along(area: f32, sp: &SurfacePoint, wi: Vec3, dist: f32) -> f32 {
+    let cos_l = sp.ng.dot(wi).abs();
+    if cos_l > 0.0 {
+        dist * dist / (area * cos_l)
+    } else {
+        0.0
+    }
+}
+
+/// The sample at point `sp` of a light of this radiance, if it faces `ref_p` and
+/// `pdf(wi, dist)` gives it a usable density.
+#[inline]
+pub(crate) fn sample_at(
+    radiance: Rgb,
+    ref_p: Vec3,
+    sp: &SurfacePoint,
+    pdf: impl FnOnce(Vec3, f32) -> f32,
+) -> Option<LightSample> {
+    let (wi, dist) = facing(ref_p, sp)?;
+    let pdf = pdf(wi, dist);
+    (pdf > 0.0 && pdf.is_finite()).then_some(LightSample {
+        p: sp.p,
+        ng: sp.ng,
+        err_scale: sp.err_scale,
+        wi,
+        dist,
+        li: radiance,
+        pdf,
+        delta: false,
+    })
 }
 
 /// Whether a sphere is sampled by its visible cone from `ref_p`: only from outside, and only
@@ -68,15 +105,10 @@ impl AreaLight {
     /// `area_pdf` for a light point already known to face the reference point along `wi`.
     #[inline]
     fn area_pdf_along(&self, sp: &SurfacePoint, wi: Vec3, dist: f32) -> f32 {
-        let cos_l = sp.ng.dot(wi).abs();
-        if cos_l > 0.0 {
-            dist * dist / (self.area * cos_l)
-        } else {
-            0.0
-        }
+        area_pdf_along(self.area, sp, wi, dist)
     }
 
-    /// The sample at light point `sp`, if it faces `ref_p`; `pdf(wi, dist)` gives its density.
+    /// `sample_at` with this light's radiance.
     #[inline]
     fn make_sample(
         &self,
@@ -84,18 +116,7 @@ impl AreaLight {
         sp: &SurfacePoint,
         pdf: impl FnOnce(Vec3, f32) -> f32,
     ) -> Option<LightSample> {
-        let (wi, dist) = facing(ref_p, sp)?;
-        let pdf = pdf(wi, dist);
-        (pdf > 0.0 && pdf.is_finite()).then_some(LightSample {
-            p: sp.p,
-            ng: sp.ng,
-            err_scale: sp.err_scale,
-            wi,
-            dist,
-            li: self.radiance,
-            pdf,
-            delta: false,
-        })
+        sample_at(self.radiance, ref_p, sp, pdf)
     }
 
     pub fn sample(

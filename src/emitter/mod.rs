@@ -4,6 +4,7 @@ mod area;
 mod select;
 
 pub use area::AreaLight;
+pub(crate) use area::{area_pdf_along, sample_at};
 pub use select::{EmitterSelection, EmitterSelector};
 
 use crate::geometry::{Shape, SurfacePoint};

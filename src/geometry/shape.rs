@@ -65,13 +65,6 @@ impl Mesh {
         }
     }
 
-    /// The point at barycentrics (b1, b2) of a triangle's vertices.
-    #[inline(always)]
-    pub fn interpolate([a, v1, v2]: [Vec3; 3], b: Vec2) -> Vec3 {
-        let b0 = 1.0 - b.x - b.y;
-        a * b0 + v1 * b.x + v2 * b.y
-    }
-
     /// A triangle's unit face normal and error scale (see `face`).
     #[inline(always)]
     pub fn face(&self, tri: usize) -> (Vec3, Vec3) {
@@ -98,10 +91,28 @@ impl Mesh {
     /// rather than to the ray's length.
     #[inline]
     pub fn surface_point(&self, tri: usize, b: Vec2, shape: u32) -> SurfacePoint {
-        let p = Mesh::interpolate(self.vertices(tri), b);
-        let (ng, err_scale) = self.face[tri];
-        let (ng, ns) = match self.vertex_normals(tri) {
-            Some(n) => Mesh::shading_normals(ng, n, b),
+        let (v, normals) = (self.vertices(tri), self.vertex_normals(tri));
+        Mesh::point_from(v, self.face[tri], normals, b, shape, tri as u32)
+    }
+
+    /// `surface_point` from the triangle's data already gathered: vertices, `face(tri)` and
+    /// `vertex_normals(tri)`. Degenerate (zero or opposing) vertex normals fall back to the
+    /// face normal; the geometric normal is turned to the shading normal's side.
+    #[inline(always)]
+    pub fn point_from(
+        [a, v1, v2]: [Vec3; 3],
+        (ng, err_scale): (Vec3, Vec3),
+        normals: Option<[Vec3; 3]>,
+        b: Vec2,
+        shape: u32,
+        prim: u32,
+    ) -> SurfacePoint {
+        let b0 = 1.0 - b.x - b.y;
+        let p = a * b0 + v1 * b.x + v2 * b.y;
+        let ns = normals.and_then(|[n0, n1, n2]| (n0 * b0 + n1 * b.x + n2 * b.y).try_normalize());
+        let (ng, ns) = match ns {
+            Some(ns) if ng.dot(ns) < 0.0 => (-ng, ns),
+            Some(ns) => (ng, ns),
             None => (ng, ng),
         };
         SurfacePoint {
@@ -109,7 +120,7 @@ impl Mesh {
             ng,
             ns,
             shape,
-            prim: tri as u32,
+            prim,
             err_scale,
         }
     }
@@ -119,19 +130,6 @@ impl Mesh {
     pub fn vertex_normals(&self, tri: usize) -> Option<[Vec3; 3]> {
         let normals = self.normals.as_ref()?;
         Some(self.indices[tri].map(|i| normals[i as usize]))
-    }
-
-    /// (geometric, shading) normal at barycentrics `b` from the face normal `ng` and the
-    /// vertex normals: the interpolated normal, with `ng` turned to its side. Degenerate
-    /// (zero or opposing) vertex normals fall back to the face normal.
-    #[inline(always)]
-    pub fn shading_normals(ng: Vec3, [n0, n1, n2]: [Vec3; 3], b: Vec2) -> (Vec3, Vec3) {
-        let b0 = 1.0 - b.x - b.y;
-        match (n0 * b0 + n1 * b.x + n2 * b.y).try_normalize() {
-            Some(ns) if ng.dot(ns) < 0.0 => (-ng, ns),
-            Some(ns) => (ng, ns),
-            None => (ng, ng),
-        }
     }
 
     pub fn bounds_scale(&self) -> f32 {

@@ -52,15 +52,13 @@ struct Shading<'m> {
 
 impl<'a> Direct<'a> {
     pub fn new(scene: &'a Scene, strategy: Strategy) -> Self {
-        let mut direct = Direct {
+        Direct {
             scene,
             strategy,
             selector: EmitterSelector::new(&scene.emitters, strategy.selection),
             has_delta_lights: scene.emitters.iter().any(|e| e.is_delta()),
-            lane_lights: None,
-        };
-        direct.lane_lights = lane_lights(&direct);
-        direct
+            lane_lights: lane_lights(scene, &strategy),
+        }
     }
 
     /// Radiance along a camera ray.

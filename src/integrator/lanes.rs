@@ -7,22 +7,21 @@
 //! sample is bitwise what `li` gives it (`render` tests this on the bundled scenes).
 //!
 //! It covers the configuration of the study's figures: MIS with one light and one BSDF sample,
-//! area sampling, every emitter a mesh area light without vertex normals. A camera hit whose
-//! material is not one-sided diffuse goes to `li_hit`, the scalar definition.
+//! area sampling, every emitter a mesh area light. A camera hit whose material is not
+//! one-sided diffuse goes to `li_hit`, the scalar definition; other configurations go to `li`.
 
 // Lane loops index a dozen structure-of-arrays fields by the same lane number; iterators
 // over one of them would hide that symmetry.
 #![allow(clippy::needless_range_loop)]
 
 use super::direct::{heuristic, Direct};
+use super::Strategy;
 use crate::bsdf::{BsdfKind, BsdfSample, Diffuse};
-use crate::emitter::{Emitter, LightSampling};
+use crate::emitter::{area_pdf_along, sample_at, AreaLight, Emitter, LightSampling};
 use crate::geometry::{Mesh, Ray, ShapeKind, NO_SKIP};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
-use crate::sampling::warps::{
-    square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf, square_to_uniform_triangle,
-};
+use crate::sampling::warps::square_to_uniform_triangle;
 use crate::sampling::AliasTable;
 use crate::scene::desc::StrategyKind;
 use crate::scene::Scene;
@@ -48,18 +47,16 @@ impl V3x8 {
     }
 }
 
-/// An emitter the lanes can sample: a mesh area light.
+/// An emitter the lanes can sample: a mesh area light, its mesh and its triangle table.
 pub(super) struct LaneLight<'a> {
+    light: &'a AreaLight,
     mesh: &'a Mesh,
     triangles: &'a AliasTable,
-    radiance: Rgb,
-    area: f32,
 }
 
 /// The lane lights, one per emitter, if the scene and strategy are the configuration the
 /// lanes cover; otherwise None and `Direct` shades every sample with `li`.
-pub(super) fn lane_lights<'a>(direct: &Direct<'a>) -> Option<Vec<LaneLight<'a>>> {
-    let (scene, s) = (direct.scene, &direct.strategy);
+pub(super) fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>> {
     let covered = s.kind == StrategyKind::Mis
         && s.emitter_samples == 1
         && s.bsdf_samples == 1
@@ -72,15 +69,16 @@ pub(super) fn lane_lights<'a>(direct: &Direct<'a>) -> Option<Vec<LaneLight<'a>>>
         .emitters
         .iter()
         .map(|e| match e {
-            Emitter::Area(a) => match (&scene.shapes[a.shape as usize].kind, &a.triangles) {
-                (ShapeKind::Mesh(mesh), Some(triangles)) => Some(LaneLight {
-                    mesh,
-                    triangles,
-                    radiance: a.radiance,
-                    area: a.area,
-                }),
-                _ => None,
-            },
+            Emitter::Area(light) => {
+                match (&scene.shapes[light.shape as usize].kind, &light.triangles) {
+                    (ShapeKind::Mesh(mesh), Some(triangles)) => Some(LaneLight {
+                        light,
+                        mesh,
+                        triangles,
+                    }),
+                    _ => None,
+                }
+            }
             Emitter::Point(_) => None,
         })
         .collect()
@@ -103,15 +101,17 @@ struct CameraHits {
     l: [Option<Rgb>; LANES],
 }
 
-/// The light sample of each lane, drawn with scalar table lookups.
+/// The light triangle of each lane and its data, gathered with scalar table lookups.
 #[derive(Default)]
 struct LightDraws {
     v: [V3x8; 3],
+    ng: V3x8,
+    err: V3x8,
     /// Vertex normals, where the mesh has them (`has_normals`).
     n: [V3x8; 3],
     has_normals: [bool; LANES],
-    ng: V3x8,
-    err: V3x8,
+    shape: [u32; LANES],
+    tri: [u32; LANES],
     radiance: V3x8,
     area: [f32; LANES],
     pmf: [f32; LANES],
@@ -132,12 +132,14 @@ struct Shaded {
 
 impl Direct<'_> {
     /// `li` of the first `n` rays, each with its lane of `rng` (which must stand where `li`
-    /// would receive it).
+    /// would receive it): in lanes where they cover the scene and strategy, else one by one.
     pub fn li_lanes(&self, rays: &[Ray; LANES], n: usize, rng: &mut RngLanes) -> [Rgb; LANES] {
-        let lights = self
-            .lane_lights
-            .as_deref()
-            .expect("li_lanes needs the covered configuration (Direct::has_lanes)");
+        let Some(lights) = self.lane_lights.as_deref() else {
+            return std::array::from_fn(|i| match i < n {
+                true => self.li(&rays[i], &mut rng.lane(i)),
+                false => Rgb::ZERO,
+            });
+        };
         let mut out = [Rgb::ZERO; LANES];
         let hits = self.camera_hits(rays, n, rng, &mut out);
         // The seven numbers `li` draws after the camera's: light (emitter, triangle, point),
@@ -149,7 +151,7 @@ impl Direct<'_> {
         out
     }
 
-    /// Whether `li_lanes` covers this scene and strategy.
+    /// Whether `li_lanes` shades in lanes for this scene and strategy.
     pub fn has_lanes(&self) -> bool {
         self.lane_lights.is_some()
     }
@@ -214,14 +216,17 @@ impl Direct<'_> {
             let Some((e, pmf)) = self.selector.sample(u_emitter[i]) else {
                 continue;
             };
-            let light = &lights[e];
-            let tri = light.triangles.sample(u_tri[i]);
-            let v = light.mesh.vertices(tri);
-            let (ng, err) = light.mesh.face(tri);
-            for (k, v) in v.into_iter().enumerate() {
+            let LaneLight {
+                light,
+                mesh,
+                triangles,
+            } = &lights[e];
+            let tri = triangles.sample(u_tri[i]);
+            let (ng, err) = mesh.face(tri);
+            for (k, v) in mesh.vertices(tri).into_iter().enumerate() {
                 d.v[k].set(i, v);
             }
-            if let Some(n) = light.mesh.vertex_normals(tri) {
+            if let Some(n) = mesh.vertex_normals(tri) {
                 for (k, n) in n.into_iter().enumerate() {
                     d.n[k].set(i, n);
                 }
@@ -229,6 +234,7 @@ impl Direct<'_> {
             }
             d.ng.set(i, ng);
             d.err.set(i, err);
+            (d.shape[i], d.tri[i]) = (light.shape, tri as u32);
             d.radiance.set(i, light.radiance);
             d.area[i] = light.area;
             d.pmf[i] = pmf;
@@ -250,42 +256,40 @@ impl Direct<'_> {
             let diffuse = Diffuse {
                 reflectance: h.reflectance.get(i),
             };
-            // Light sample: `AreaLight::sample` on a mesh, `Mesh::surface_point`.
+            // Light sample: the mesh branch of `AreaLight::sample`.
             let b = square_to_uniform_triangle(Vec2::new(u[2][i], u[3][i]));
-            let lp = Mesh::interpolate([ld.v[0].get(i), ld.v[1].get(i), ld.v[2].get(i)], b);
-            let (face_ng, lerr) = (ld.ng.get(i), ld.err.get(i));
-            let vertex_normals = [ld.n[0].get(i), ld.n[1].get(i), ld.n[2].get(i)];
-            let (lng, lns) = match ld.has_normals[i] {
-                true => Mesh::shading_normals(face_ng, vertex_normals, b),
-                false => (face_ng, face_ng),
+            let v = [ld.v[0].get(i), ld.v[1].get(i), ld.v[2].get(i)];
+            let normals = [ld.n[0].get(i), ld.n[1].get(i), ld.n[2].get(i)];
+            let face = (ld.ng.get(i), ld.err.get(i));
+            let normals = ld.has_normals[i].then_some(normals);
+            let lsp = Mesh::point_from(v, face, normals, b, ld.shape[i], ld.tri[i]);
+            let area = ld.area[i];
+            let ls = sample_at(ld.radiance.get(i), p, &lsp, |wi, dist| {
+                area_pdf_along(area, &lsp, wi, dist)
+            });
+            let (drawn, wl, pdf_area, radiance) = match ls {
+                Some(ls) => (true, ls.wi, ls.pdf, ls.li),
+                None => (false, Vec3::ZERO, 0.0, Rgb::ZERO),
             };
-            let to_light = lp - p;
-            let dist = to_light.length();
-            let wl = Vec3::new(to_light.x / dist, to_light.y / dist, to_light.z / dist);
-            let faces = dist > 0.0 && lns.dot(-wl) > 0.0;
-            let cos_l = lng.dot(wl).abs();
-            let pdf_area = if cos_l > 0.0 {
-                dist * dist / (ld.area[i] * cos_l)
-            } else {
-                0.0
-            };
-            let drawn = faces && pdf_area > 0.0 && pdf_area.is_finite();
             // `light_finish` before its visibility test.
             let wo = frame.to_local(wl);
             let (f, pdf_bsdf) = (diffuse.eval(wi, wo), diffuse.pdf(wi, wo));
-            let radiance = ld.radiance.get(i);
             let p_light = ld.pmf[i] * pdf_area;
             let w = heuristic(s.heuristic, ne * p_light, nb * pdf_bsdf);
             o.light.set(i, f * radiance * (w / p_light));
             o.light_ok[i] = drawn && f != Rgb::ZERO && radiance != Rgb::ZERO;
+            let lp = lsp.p;
             let so = offset_origin(p, ng, err, lp - p);
             o.shadow_o.set(i, so);
             o.shadow_target
-                .set(i, offset_origin(lp, lng, lerr, so - lp));
-            // BSDF sample: `Diffuse::sample` and `Scene::bsdf_ray`.
-            let wo = square_to_cosine_hemisphere(Vec2::new(u[5][i], u[6][i]));
-            let pdf = square_to_cosine_hemisphere_pdf(wo);
-            o.bsdf_ok[i] = !(wi.z <= 0.0) && !(pdf <= 0.0);
+                .set(i, offset_origin(lp, lsp.ng, lsp.err_scale, so - lp));
+            // BSDF sample and `Scene::bsdf_ray`'s origin.
+            let bs = diffuse.sample(wi, Vec2::new(u[5][i], u[6][i]));
+            let (bsdf_ok, wo, pdf) = match bs {
+                Some(bs) => (true, bs.wo, bs.pdf),
+                None => (false, Vec3::Z, 0.0),
+            };
+            o.bsdf_ok[i] = bsdf_ok;
             o.bsdf_pdf[i] = pdf;
             let d = frame.to_world(wo);
             o.bsdf_d.set(i, d);
