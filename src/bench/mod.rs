@@ -233,20 +233,30 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             }
         }
         // The ray-tracing limit for the same ray mix, on one thread, against the 1-thread
-        // render time of power MIS (which traces that mix).
-        let mix = raylimit::ray_mix(&scene, (a.spp / 16).max(1));
-        let limit = raylimit::measure(&scene, &mix, a.repeat);
+        // render time of power MIS (which traces that mix). Whole groups of LANES samples per
+        // pixel, as the renderer traces them.
+        let mix_spp = (a.spp / 16)
+            .max(1)
+            .next_multiple_of(crate::rng::LANES as u32);
+        let mix = raylimit::ray_mix(&scene, mix_spp);
         let mis = bench_strategies()[0];
-        let render_sps = throughput(&scene, mis, a.spp, 1, a.repeat);
-        let outside = 1.0 - limit.seconds_per_sample * render_sps;
+        let limit = raylimit::measure(&scene, &mix, a.repeat, || {
+            throughput(&scene, mis, a.spp, 1, 1)
+        });
         println!(
-            "  ray-tracing limit ({name}, 1 thread): {:.2} M closest-hit rays/s, {:.2} M occlusion rays/s, {:.2} M BSDF-ray emitter queries/s; {:.2} M samples/s if tracing were all; {:.0}% of {} render time outside traversal",
-            limit.closest_per_s / 1e6,
-            limit.occlusion_per_s / 1e6,
-            limit.bsdf_query_per_s.unwrap_or(f64::NAN) / 1e6,
-            1.0 / limit.seconds_per_sample / 1e6,
-            outside * 100.0,
-            mis.label()
+            "  ray-tracing limit ({name}, 1 thread): {:.2} M closest-hit rays/s, {:.2} M occlusion rays/s, {:.2} M BSDF-ray emitter queries/s; {:.2} M samples/s if tracing were all ({:.2} M with each ray type traced back to back)",
+            limit.by_type.closest_per_s / 1e6,
+            limit.by_type.occlusion_per_s / 1e6,
+            limit.bsdf_query_per_s / 1e6,
+            1.0 / limit.render_order_seconds_per_sample / 1e6,
+            1.0 / limit.by_type.seconds_per_sample / 1e6,
+        );
+        println!(
+            "  {} at {:.2} M samples/s: {:.0}% of render time outside traversal ({:.0}% against the traversal by type)",
+            mis.label(),
+            limit.render_per_s / 1e6,
+            limit.share_outside * 100.0,
+            limit.share_outside_by_type * 100.0,
         );
         let raw = raylimit::measure_obvhs(&scene, &mix, a.repeat);
         println!(
@@ -255,14 +265,26 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             raw.occlusion_per_s / 1e6,
         );
         for (what, v, unit) in [
-            ("closest_hit_rays", limit.closest_per_s, "rays/s"),
-            ("occlusion_rays", limit.occlusion_per_s, "rays/s"),
+            ("closest_hit_rays", limit.by_type.closest_per_s, "rays/s"),
+            ("occlusion_rays", limit.by_type.occlusion_per_s, "rays/s"),
+            ("bsdf_emitter_query_rays", limit.bsdf_query_per_s, "rays/s"),
             (
-                "bsdf_emitter_query_rays",
-                limit.bsdf_query_per_s.unwrap_or(f64::NAN),
-                "rays/s",
+                "traversal_only_render_order",
+                1.0 / limit.render_order_seconds_per_sample,
+                "samples/s",
             ),
-            ("share_outside_traversal", outside, "fraction"),
+            (
+                "traversal_only_by_type",
+                1.0 / limit.by_type.seconds_per_sample,
+                "samples/s",
+            ),
+            ("render_1_thread", limit.render_per_s, "samples/s"),
+            ("share_outside_traversal", limit.share_outside, "fraction"),
+            (
+                "share_outside_traversal_by_type",
+                limit.share_outside_by_type,
+                "fraction",
+            ),
             ("obvhs_closest_hit_rays", raw.closest_per_s, "rays/s"),
             ("obvhs_occlusion_rays", raw.occlusion_per_s, "rays/s"),
         ] {

@@ -11,7 +11,7 @@ use crate::emitter::LightSampling;
 use crate::geometry::shape::intersect_sphere;
 use crate::geometry::{Hit, Ray, ShapeKind};
 use crate::math::Frame;
-use crate::rng::Rng;
+use crate::rng::{Rng, LANES};
 use crate::sampling::warps::square_to_cosine_hemisphere;
 use crate::scene::Scene;
 use std::time::Instant;
@@ -21,6 +21,9 @@ pub struct RayMix {
     pub shadow: Vec<Ray>,
     /// BSDF rays with the triangle the emitter-only structure skips for them.
     pub bsdf: Vec<(Ray, u32)>,
+    /// Per camera ray, the index of its shadow ray and of its BSDF ray, if it has them: the
+    /// order in which the renderer traces them.
+    pub follow_ups: Vec<(Option<u32>, Option<u32>)>,
 }
 
 /// The ray mix of `spp` samples per pixel of the scene's camera.
@@ -30,6 +33,7 @@ pub fn ray_mix(scene: &Scene, spp: u32) -> RayMix {
         camera: Vec::new(),
         shadow: Vec::new(),
         bsdf: Vec::new(),
+        follow_ups: Vec::new(),
     };
     for y in 0..cam.height {
         for x in 0..cam.width {
@@ -37,9 +41,11 @@ pub fn ray_mix(scene: &Scene, spp: u32) -> RayMix {
                 let mut rng = Rng::for_sample(7, (y * cam.width + x) as u64, s as u64);
                 let ray = cam.generate_ray(x, y, &mut rng);
                 mix.camera.push(ray);
+                mix.follow_ups.push((None, None));
                 let Some(hit) = scene.intersect(&ray) else {
                     continue;
                 };
+                let follow = mix.follow_ups.last_mut().expect("pushed above");
                 let sp = hit.sp;
                 let e = ((rng.next_f32() * scene.emitters.len() as f32) as usize)
                     .min(scene.emitters.len() - 1);
@@ -47,10 +53,12 @@ pub fn ray_mix(scene: &Scene, spp: u32) -> RayMix {
                 if let Some(ls) =
                     scene.emitters[e].sample(&scene.shapes, sp.p, u_prim, u, LightSampling::Area)
                 {
+                    follow.0 = Some(mix.shadow.len() as u32);
                     mix.shadow.push(scene.shadow_ray(&sp, &ls));
                 }
                 let d =
                     Frame::from_normal(sp.ns).to_world(square_to_cosine_hemisphere(rng.next_2d()));
+                follow.1 = Some(mix.bsdf.len() as u32);
                 mix.bsdf.push(scene.bsdf_ray(&sp, d));
             }
         }
@@ -63,9 +71,8 @@ pub struct RayLimit {
     /// obvhs trace the same queries) and of occlusion queries.
     pub closest_per_s: f64,
     pub occlusion_per_s: f64,
-    /// BSDF rays per second with the renderer's emitter query (directlab only).
-    pub bsdf_query_per_s: Option<f64>,
-    /// Seconds the renderer's queries need for the mix of one camera sample.
+    /// Seconds the renderer's queries need for the mix of one camera sample, each ray type
+    /// traced back to back.
     pub seconds_per_sample: f64,
 }
 
@@ -76,19 +83,51 @@ impl RayLimit {
         RayLimit {
             closest_per_s: n_closest / best.0,
             occlusion_per_s: mix.shadow.len() as f64 / best.1,
-            bsdf_query_per_s: None,
             seconds_per_sample: (best.0 + best.1) / mix.camera.len() as f64,
         }
     }
 }
 
-/// Times the mix on one thread, best of `repeat`.
-pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
+/// directlab's traversal of the mix against a render of the scene.
+pub struct Limit {
+    /// Best rates, each ray type traced back to back.
+    pub by_type: RayLimit,
+    /// BSDF rays per second with the renderer's emitter query.
+    pub bsdf_query_per_s: f64,
+    /// Best seconds per camera sample for the mix traced in the renderer's order: the
+    /// camera rays of `LANES` samples of a pixel, then each sample's shadow and BSDF ray.
+    pub render_order_seconds_per_sample: f64,
+    /// Best samples per second of the render.
+    pub render_per_s: f64,
+    /// Share of render time outside traversal, median over the repetitions, with traversal
+    /// timed in the renderer's order and by type. Each repetition times the mix and the
+    /// render one after the other, so a slow spell of the machine hits both sides of the
+    /// ratio instead of one.
+    pub share_outside: f64,
+    pub share_outside_by_type: f64,
+}
+
+fn median(mut x: Vec<f64>) -> f64 {
+    x.sort_by(f64::total_cmp);
+    let n = x.len();
+    if n % 2 == 1 {
+        x[n / 2]
+    } else {
+        0.5 * (x[n / 2 - 1] + x[n / 2])
+    }
+}
+
+/// Times the mix on one thread and `render` (one 1-thread render, returning its samples per
+/// second), alternately, `repeat` times.
+pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut() -> f64) -> Limit {
     // Best seconds of: camera rays, BSDF rays as closest hits, BSDF rays as the renderer
-    // asks them, shadow rays.
-    let mut best = [f64::INFINITY; 4];
+    // asks them, shadow rays, all in the renderer's order.
+    let mut best = [f64::INFINITY; 5];
+    let mut best_render = 0.0f64;
+    let (mut shares, mut shares_by_type) = (Vec::new(), Vec::new());
     let mut sink = 0usize;
     let prim = |h: Option<Hit>| h.map_or(0, |h| h.sp.prim as usize & 1);
+    let n = mix.camera.len() as f64;
     for _ in 0..repeat.max(1) {
         let t = Instant::now();
         for r in &mix.camera {
@@ -110,20 +149,48 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
             sink += scene.accel.occluded(r) as usize;
         }
         let occl = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        for g in (0..mix.camera.len()).step_by(LANES) {
+            let group = g..(g + LANES).min(mix.camera.len());
+            for i in group.clone() {
+                sink += prim(scene.intersect(&mix.camera[i]));
+            }
+            for i in group {
+                let (shadow, bsdf) = mix.follow_ups[i];
+                if let Some(s) = shadow {
+                    sink += scene.accel.occluded(&mix.shadow[s as usize]) as usize;
+                }
+                if let Some(b) = bsdf {
+                    let (r, skip) = &mix.bsdf[b as usize];
+                    sink += prim(scene.bsdf_ray_hit(r, *skip));
+                }
+            }
+        }
+        let in_order = t.elapsed().as_secs_f64();
+        let render_per_s = render();
+        shares.push(1.0 - in_order / n * render_per_s);
+        shares_by_type.push(1.0 - (camera + bsdf_query + occl) / n * render_per_s);
+        best_render = best_render.max(render_per_s);
         for (b, x) in best
             .iter_mut()
-            .zip([camera, bsdf_closest, bsdf_query, occl])
+            .zip([camera, bsdf_closest, bsdf_query, occl, in_order])
         {
             *b = b.min(x);
         }
     }
     std::hint::black_box(sink);
-    let [camera, bsdf_closest, bsdf_query, occl] = best;
-    RayLimit {
-        closest_per_s: (mix.camera.len() + mix.bsdf.len()) as f64 / (camera + bsdf_closest),
-        occlusion_per_s: mix.shadow.len() as f64 / occl,
-        bsdf_query_per_s: Some(mix.bsdf.len() as f64 / bsdf_query),
-        seconds_per_sample: (camera + bsdf_query + occl) / mix.camera.len() as f64,
+    let [camera, bsdf_closest, bsdf_query, occl, in_order] = best;
+    Limit {
+        by_type: RayLimit {
+            closest_per_s: (mix.camera.len() + mix.bsdf.len()) as f64 / (camera + bsdf_closest),
+            occlusion_per_s: mix.shadow.len() as f64 / occl,
+            seconds_per_sample: (camera + bsdf_query + occl) / n,
+        },
+        bsdf_query_per_s: mix.bsdf.len() as f64 / bsdf_query,
+        render_order_seconds_per_sample: in_order / n,
+        render_per_s: best_render,
+        share_outside: median(shares),
+        share_outside_by_type: median(shares_by_type),
     }
 }
 
