@@ -26,6 +26,9 @@ pub struct RenderOutput {
     pub variance: Image,
     pub spp: u32,
     pub seconds: f64,
+    /// Seconds the workers spent rendering tiles, summed over tiles: `seconds` times the
+    /// thread count when no worker waits (it separates idle workers from slower ones).
+    pub busy_seconds: f64,
     pub non_finite_samples: u64,
 }
 
@@ -78,6 +81,9 @@ impl PixelStats {
         (mean, var_of_mean)
     }
 }
+
+/// A tile's pixels and the seconds its worker spent on them.
+type TileResult = (Vec<(u32, u32, PixelResult)>, f64);
 
 struct PixelResult {
     mean: [f64; 3],
@@ -141,10 +147,15 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
         .build()
         .expect("thread pool");
     let start = Instant::now();
-    let results: Vec<Vec<(u32, u32, PixelResult)>> = pool.install(|| {
+    let results: Vec<TileResult> = pool.install(|| {
+        // One tile per work item: rayon otherwise hands each worker a fixed quarter of the
+        // tiles and splits further only on a steal, so a worker that runs slower for a while
+        // (a shared VM core) leaves the other one idle at the end.
         tiles
             .par_iter()
+            .with_max_len(1)
             .map(|&(x0, y0)| {
+                let tile_start = Instant::now();
                 let mut out = Vec::with_capacity((TILE * TILE) as usize);
                 for y in y0..(y0 + TILE).min(h) {
                     for x in x0..(x0 + TILE).min(w) {
@@ -152,7 +163,7 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
                     }
                 }
                 bar.inc(1);
-                out
+                (out, tile_start.elapsed().as_secs_f64())
             })
             .collect()
     });
@@ -161,7 +172,8 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
     let mut mean = Image::new(w, h);
     let mut variance = Image::new(w, h);
     let mut non_finite_samples = 0;
-    for (x, y, r) in results.into_iter().flatten() {
+    let busy_seconds = results.iter().map(|r| r.1).sum();
+    for (x, y, r) in results.into_iter().flat_map(|r| r.0) {
         mean.set(x, y, r.mean);
         variance.set(x, y, r.var_of_mean);
         non_finite_samples += r.non_finite;
@@ -171,6 +183,7 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
         variance,
         spp: settings.spp,
         seconds,
+        busy_seconds,
         non_finite_samples,
     }
 }

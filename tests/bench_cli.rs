@@ -32,6 +32,7 @@ fn bench_writes_every_section() {
     for printed in [
         "M samples/s",
         "1->2",
+        "workers busy",
         "ray-tracing limit",
         "of render time outside traversal",
         "raw obvhs",
@@ -61,6 +62,11 @@ fn bench_writes_every_section() {
     let strategies = 7;
     assert_eq!(sections["throughput"], strategies * 2, "{sections:?}");
     assert_eq!(sections["thread_scaling"], strategies, "{sections:?}");
+    assert_eq!(sections["thread_busy"], strategies, "{sections:?}");
+    assert_eq!(
+        sections["thread_work_per_sample"], strategies,
+        "{sections:?}"
+    );
     // directlab: closest-hit, occlusion and emitter-query rates, traversal-only samples/s in
     // the renderer's order and by ray type, the render, the two shares; obvhs: two rates.
     assert_eq!(sections["ray_limit"], 10, "{sections:?}");

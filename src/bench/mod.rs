@@ -104,7 +104,17 @@ fn throughput(
     threads: usize,
     repeat: u32,
 ) -> f64 {
-    throughputs(scene, strategy, spp, &[threads], repeat)[0]
+    throughputs(scene, strategy, spp, &[threads], repeat)[0].samples_per_s
+}
+
+/// The fastest of a thread count's timed renders.
+#[derive(Clone, Copy)]
+struct Timed {
+    samples_per_s: f64,
+    /// Share of the workers' time spent in tiles (the rest is waiting).
+    busy: f64,
+    /// Worker seconds per sample.
+    work_per_sample: f64,
 }
 
 /// Samples per second at each thread count, best of `repeat`. The thread counts take turns
@@ -116,8 +126,10 @@ fn throughputs(
     spp: u32,
     threads: &[usize],
     repeat: u32,
-) -> Vec<f64> {
-    let mut best = vec![f64::INFINITY; threads.len()];
+) -> Vec<Timed> {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let samples = w as f64 * h as f64 * spp as f64;
+    let mut best: Vec<Option<Timed>> = vec![None; threads.len()];
     for _ in 0..repeat.max(1) {
         for (b, &t) in best.iter_mut().zip(threads) {
             let settings = RenderSettings {
@@ -126,12 +138,19 @@ fn throughputs(
                 threads: Some(t),
                 progress: false,
             };
-            *b = b.min(render(scene, strategy, &settings).seconds);
+            let out = render(scene, strategy, &settings);
+            let timed = Timed {
+                samples_per_s: samples / out.seconds,
+                busy: out.busy_seconds / (out.seconds * t as f64),
+                work_per_sample: out.busy_seconds / samples,
+            };
+            if b.is_none_or(|b| timed.samples_per_s > b.samples_per_s) {
+                *b = Some(timed);
+            }
         }
     }
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    best.iter()
-        .map(|b| w as f64 * h as f64 * spp as f64 / b)
+    best.into_iter()
+        .map(|b| b.expect("at least one repetition"))
         .collect()
 }
 
@@ -189,14 +208,14 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         let name = path.display().to_string();
         for strategy in bench_strategies() {
             let all = throughputs(&scene, strategy, a.spp, &a.threads, a.repeat);
-            let by_threads: Vec<(usize, f64)> = a.threads.iter().copied().zip(all).collect();
-            for &(threads, sps) in &by_threads {
+            let by_threads: Vec<(usize, Timed)> = a.threads.iter().copied().zip(all).collect();
+            for &(threads, timed) in &by_threads {
                 println!(
                     "  {:<34} {:<26} {:>7} {:>12.2}",
                     name,
                     strategy.label(),
                     threads,
-                    sps / 1e6
+                    timed.samples_per_s / 1e6
                 );
                 rows.push(Row {
                     section: "throughput",
@@ -204,31 +223,42 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                     strategy: strategy.label(),
                     threads,
                     n: 0,
-                    value: sps,
+                    value: timed.samples_per_s,
                     unit: "samples/s",
                 });
             }
-            // Speed-up from the fewest to the most threads measured.
+            // Speed-up from the fewest to the most threads measured, split into its two
+            // causes: the speed-up is t2/t1 x (busy share ratio) / (work per sample ratio).
             let lo = by_threads.iter().min_by_key(|t| t.0);
             let hi = by_threads.iter().max_by_key(|t| t.0);
             if let (Some(&(t1, s1)), Some(&(t2, s2))) = (lo, hi) {
                 if t2 > t1 {
+                    let speed_up = s2.samples_per_s / s1.samples_per_s;
+                    let work = s2.work_per_sample / s1.work_per_sample;
                     println!(
-                        "  {:<34} {:<26} {:>7} {:>11.2}x",
+                        "  {:<34} {:<26} {:>7} {:>11.2}x  (workers busy {:.1}%, work per sample {:.3}x the {t1}-thread's)",
                         "",
                         "",
                         format!("{t1}->{t2}"),
-                        s2 / s1
+                        speed_up,
+                        s2.busy * 100.0,
+                        work,
                     );
-                    rows.push(Row {
-                        section: "thread_scaling",
-                        scene: name.clone(),
-                        strategy: strategy.label(),
-                        threads: t2,
-                        n: t1 as u64,
-                        value: s2 / s1,
-                        unit: "speed-up",
-                    });
+                    for (section, value, unit) in [
+                        ("thread_scaling", speed_up, "speed-up"),
+                        ("thread_busy", s2.busy, "fraction"),
+                        ("thread_work_per_sample", work, "ratio"),
+                    ] {
+                        rows.push(Row {
+                            section,
+                            scene: name.clone(),
+                            strategy: strategy.label(),
+                            threads: t2,
+                            n: t1 as u64,
+                            value,
+                            unit,
+                        });
+                    }
                 }
             }
         }
