@@ -107,14 +107,9 @@ pub struct Limit {
     pub share_outside_by_type: f64,
 }
 
-fn median(mut x: Vec<f64>) -> f64 {
-    x.sort_by(f64::total_cmp);
-    let n = x.len();
-    if n % 2 == 1 {
-        x[n / 2]
-    } else {
-        0.5 * (x[n / 2 - 1] + x[n / 2])
-    }
+fn median(x: Vec<f64>) -> f64 {
+    use statrs::statistics::{Data, Median};
+    Data::new(x).median()
 }
 
 /// Times the mix on one thread and `render` (one 1-thread render, returning its samples per
