@@ -116,7 +116,7 @@ fn median(x: Vec<f64>) -> f64 {
 /// second), alternately, `repeat` times.
 pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut() -> f64) -> Limit {
     // Best seconds of: camera rays, BSDF rays as closest hits, BSDF rays as the renderer
-    // asks them, shadow rays, all in the renderer's order.
+    // asks them, shadow rays, and the whole mix in the renderer's order.
     let mut best = [f64::INFINITY; 5];
     let mut best_render = 0.0f64;
     let (mut shares, mut shares_by_type) = (Vec::new(), Vec::new());
