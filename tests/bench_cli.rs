@@ -20,11 +20,18 @@ fn bench_writes_every_section() {
             "--res",
             "16",
             "--repeat",
-            "1",
+            "2",
             "--threads",
             "1,2",
         ])
-        .args(["--max-triangles", "10000", "--max-emitters", "10"])
+        .args([
+            "--max-triangles",
+            "10000",
+            "--max-emitters",
+            "10",
+            "--sweep-spp",
+            "4",
+        ])
         .arg("--out")
         .arg(&out));
     let stdout = String::from_utf8_lossy(&o.stdout);
@@ -33,6 +40,7 @@ fn bench_writes_every_section() {
         "M samples/s",
         "1->2",
         "workers busy",
+        "slowest run",
         "ray-tracing limit",
         "of render time outside traversal",
         "raw obvhs",
@@ -46,6 +54,7 @@ fn bench_writes_every_section() {
 
     let mut r = csv::Reader::from_path(&out).unwrap();
     let mut sections: HashMap<String, usize> = HashMap::new();
+    let mut speeds: HashMap<(String, String, String), f64> = HashMap::new();
     for row in r.records() {
         let row = row.unwrap();
         let value: f64 = row[5].parse().unwrap();
@@ -58,9 +67,27 @@ fn bench_writes_every_section() {
             assert!(value.is_finite() && value > 0.0, "{what}: {value}");
         }
         *sections.entry(row[0].to_string()).or_default() += 1;
+        if row[0].starts_with("throughput") {
+            speeds.insert(
+                (row[0].to_string(), row[2].to_string(), row[3].to_string()),
+                value,
+            );
+        }
+    }
+    // The slowest of the repetitions is never faster than the reported (fastest) one.
+    for ((section, strategy, threads), slowest) in &speeds {
+        if section == "throughput_slowest" {
+            let best = speeds[&("throughput".into(), strategy.clone(), threads.clone())];
+            assert!(*slowest <= best, "{strategy} {threads}: {slowest} > {best}");
+        }
     }
     let strategies = 7;
     assert_eq!(sections["throughput"], strategies * 2, "{sections:?}");
+    assert_eq!(
+        sections["throughput_slowest"],
+        strategies * 2,
+        "{sections:?}"
+    );
     assert_eq!(sections["thread_scaling"], strategies, "{sections:?}");
     assert_eq!(sections["thread_busy"], strategies, "{sections:?}");
     assert_eq!(

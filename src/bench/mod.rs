@@ -33,6 +33,12 @@ pub struct BenchArgs {
     /// because on a shared 2-core VM three still let one slow spell decide a 2-thread number.
     #[arg(long, default_value_t = 5)]
     pub repeat: u32,
+    /// Samples per pixel of each timed render of the triangle and emitter sweeps (64x64
+    /// pixels). At 64 spp a render lasted 25-60 ms and its speed spread by up to 50 % between
+    /// repetitions on this VM (scheduler ticks, thread start-up), which best-of-5 did not
+    /// remove; at 512 (0.2-0.4 s) the spread is 3-6 %.
+    #[arg(long, default_value_t = 512)]
+    pub sweep_spp: u32,
     /// Largest triangle count of the triangle-scaling sweep (1e3, 1e4, ... up to this).
     #[arg(long, default_value_t = 1_000_000)]
     pub max_triangles: usize,
@@ -115,6 +121,9 @@ struct Timed {
     busy: f64,
     /// Worker seconds per sample.
     work_per_sample: f64,
+    /// Samples per second of the slowest repetition: how far this machine's interference
+    /// moved the runs.
+    slowest_samples_per_s: f64,
 }
 
 /// Samples per second at each thread count, best of `repeat`. The thread counts take turns
@@ -143,9 +152,16 @@ fn throughputs(
                 samples_per_s: samples / out.seconds,
                 busy: out.busy_seconds / (out.seconds * t as f64),
                 work_per_sample: out.busy_seconds / samples,
+                slowest_samples_per_s: samples / out.seconds,
             };
+            let slowest = b.map_or(timed.samples_per_s, |b| {
+                b.slowest_samples_per_s.min(timed.samples_per_s)
+            });
             if b.is_none_or(|b| timed.samples_per_s > b.samples_per_s) {
                 *b = Some(timed);
+            }
+            if let Some(b) = b {
+                b.slowest_samples_per_s = slowest;
             }
         }
     }
@@ -154,13 +170,14 @@ fn throughputs(
         .collect()
 }
 
-/// Nanoseconds per emitter choice (one uniform number in, emitter and pmf out), best of 3
-/// runs of 2^22 choices. The numbers jump around the unit interval (golden-ratio sequence) as
-/// a render's do, so table lookups are not sequential.
+/// Nanoseconds per emitter choice (one uniform number in, emitter and pmf out), best of 7
+/// runs of 2^22 choices (10 ms each; best of 3 once read 3.8 ns for a table that costs 2.4).
+/// The numbers jump around the unit interval (golden-ratio sequence) as a render's do, so
+/// table lookups are not sequential.
 fn choice_ns(scene: &crate::scene::Scene, sel: EmitterSelection) -> f64 {
     let selector = crate::emitter::EmitterSelector::new(&scene.emitters, sel);
     let n = 1u32 << 22;
-    (0..3)
+    (0..7)
         .map(|_| {
             let start = std::time::Instant::now();
             let mut sink = 0usize;
@@ -200,7 +217,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         a.res, a.res, a.spp, a.repeat
     );
     println!(
-        "  {:<34} {:<26} {:>7} {:>12}",
+        "  {:<34} {:<26} {:>7} {:>12}  slowest run",
         "scene", "strategy", "threads", "M samples/s"
     );
     for path in &scenes {
@@ -211,21 +228,28 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             let by_threads: Vec<(usize, Timed)> = a.threads.iter().copied().zip(all).collect();
             for &(threads, timed) in &by_threads {
                 println!(
-                    "  {:<34} {:<26} {:>7} {:>12.2}",
+                    "  {:<34} {:<26} {:>7} {:>12.2}  {:.2} ({:.0}% below)",
                     name,
                     strategy.label(),
                     threads,
-                    timed.samples_per_s / 1e6
+                    timed.samples_per_s / 1e6,
+                    timed.slowest_samples_per_s / 1e6,
+                    (1.0 - timed.slowest_samples_per_s / timed.samples_per_s) * 100.0,
                 );
-                rows.push(Row {
-                    section: "throughput",
-                    scene: name.clone(),
-                    strategy: strategy.label(),
-                    threads,
-                    n: 0,
-                    value: timed.samples_per_s,
-                    unit: "samples/s",
-                });
+                for (section, value) in [
+                    ("throughput", timed.samples_per_s),
+                    ("throughput_slowest", timed.slowest_samples_per_s),
+                ] {
+                    rows.push(Row {
+                        section,
+                        scene: name.clone(),
+                        strategy: strategy.label(),
+                        threads,
+                        n: 0,
+                        value,
+                        unit: "samples/s",
+                    });
+                }
             }
             // Speed-up from the fewest to the most threads measured, split into its two
             // causes: the speed-up is t2/t1 x (busy share ratio) / (work per sample ratio).
@@ -331,12 +355,9 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
     }
     let mis = bench_strategies()[0];
     println!(
-        "per-sample cost as the scene grows ({} threads, power MIS):",
-        max_threads
+        "per-sample cost as the scene grows ({} threads, power MIS, 64x64 at {} spp, best of {}):",
+        max_threads, a.sweep_spp, a.repeat
     );
-    // 64x64 pixels at this spp: 262k samples per timed render, long enough (tens of ms) that
-    // one scheduler hiccup does not decide a size's cost; the scene builds dominate anyway.
-    const SWEEP_SPP: u32 = 64;
     let mut tri_costs = Vec::new();
     for n in [1_000usize, 10_000, 100_000, 1_000_000] {
         if n > a.max_triangles {
@@ -344,7 +365,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         }
         let scene =
             crate::scene::Scene::build(scaling::tessellated(n)).map_err(|e| e.to_string())?;
-        let sps = throughput(&scene, mis, SWEEP_SPP, max_threads, a.repeat);
+        let sps = throughput(&scene, mis, a.sweep_spp, max_threads, a.repeat);
         let tris = scene.accel.primitive_count() as u64;
         println!("  {:>9} triangles: {:>8.1} ns/sample", tris, 1e9 / sps);
         tri_costs.push(1e9 / sps);
@@ -372,7 +393,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             }
             let scene =
                 crate::scene::Scene::build(scaling::many_lights(n)).map_err(|e| e.to_string())?;
-            let sps = throughput(&scene, s, SWEEP_SPP, max_threads, a.repeat);
+            let sps = throughput(&scene, s, a.sweep_spp, max_threads, a.repeat);
             println!(
                 "  {:>9} emitters ({}): {:>8.1} ns/sample",
                 n,
