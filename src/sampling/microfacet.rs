@@ -188,12 +188,15 @@ thread_local!(pub static ITERS: std::cell::Cell<u64> = const { std::cell::Cell::
 /// for no visible digit).
 fn beckmann_visible_slope(tan_t: f64, u: f64) -> f64 {
     let k = tan_t / PI.sqrt();
-    let cdf = |x: f64| erfc(-x) + k * (-x * x).exp();
+    // C(x) from exp(-x^2), which the Newton step's derivative reuses.
+    let cdf = |x: f64, e: f64| erfc(-x) + k * e;
     // Beyond |x| = 9 both terms are below 1e-35 of the total: nothing left to sample.
     let (mut lo, mut hi) = (-9.0f64, if tan_t > 1.0 / 9.0 { 1.0 / tan_t } else { 9.0 });
-    let target = u.clamp(1e-12, 1.0 - 1e-12) * cdf(hi);
+    // hi > 0, so erfc(-hi) is exactly 2 - erfc(hi) (that is how `erfc` makes it).
+    let erfc_hi = erfc(hi);
+    let target = u.clamp(1e-12, 1.0 - 1e-12) * ((2.0 - erfc_hi) + k * (-hi * hi).exp());
     // Mitsuba 3's starting guess, in erf space: a power of 1 - u fitted in theta.
-    let c = 1.0 - erfc(hi);
+    let c = 1.0 - erfc_hi;
     let theta = tan_t.atan();
     let fit = 1.0 + theta * (-0.876 + theta * (0.4265 - 0.0594 * theta));
     let guess = c - (1.0 + c) * (1.0 - u).max(0.0).powf(fit);
@@ -201,13 +204,14 @@ fn beckmann_visible_slope(tan_t: f64, u: f64) -> f64 {
     for _it in 0..64 {
         #[cfg(test)]
         ITERS.with(|c| c.set(c.get() + 1));
-        let f = cdf(x) - target;
+        let e = (-x * x).exp();
+        let f = cdf(x, e) - target;
         if f > 0.0 {
             hi = x;
         } else {
             lo = x;
         }
-        let df = 2.0 / PI.sqrt() * (-x * x).exp() * (1.0 - x * tan_t);
+        let df = 2.0 / PI.sqrt() * e * (1.0 - x * tan_t);
         let mut next = x - f / df;
         if !(next > lo && next < hi) {
             next = 0.5 * (lo + hi);
