@@ -273,7 +273,7 @@ mod tests {
                 true,
             ),
             ("cbox-materials/cbox-materials.xml", &keep, power, false),
-            ("veach-mis/veach-mis.xml", &tent, mis, false),
+            ("veach-mis/veach-mis.xml", &tent, mis, true),
         ];
         for (rel, edit, strategy, lanes) in cases {
             let mut desc = crate::scene::bundled_tests::load(rel);

@@ -7,8 +7,9 @@
 //! sample is bitwise what `li` gives it (`render` tests this on the bundled scenes).
 //!
 //! It covers the configuration of the study's figures: MIS with one light and one BSDF sample,
-//! area sampling, every emitter a mesh area light. A camera hit whose material is not
-//! one-sided diffuse goes to `li_hit`, the scalar definition; other configurations go to `li`.
+//! area sampling, every emitter an area light on a mesh or a sphere. A camera hit whose
+//! material is not one-sided diffuse goes to `li_hit`, the scalar definition; other
+//! configurations go to `li`.
 
 // Lane loops index a dozen structure-of-arrays fields by the same lane number; iterators
 // over one of them would hide that symmetry.
@@ -18,10 +19,10 @@ use super::direct::{heuristic, Direct};
 use super::Strategy;
 use crate::bsdf::{BsdfKind, BsdfSample, Diffuse};
 use crate::emitter::{area_pdf_along, sample_at, AreaLight, Emitter, LightSampling};
-use crate::geometry::{Mesh, Ray, ShapeKind, NO_SKIP};
+use crate::geometry::{Mesh, Ray, ShapeKind, Sphere, NO_SKIP};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
-use crate::sampling::warps::square_to_uniform_triangle;
+use crate::sampling::warps::{square_to_uniform_sphere, square_to_uniform_triangle};
 use crate::sampling::AliasTable;
 use crate::scene::desc::StrategyKind;
 use crate::scene::Scene;
@@ -47,11 +48,18 @@ impl V3x8 {
     }
 }
 
-/// An emitter the lanes can sample: a mesh area light, its mesh and its triangle table.
-pub(super) struct LaneLight<'a> {
-    light: &'a AreaLight,
-    mesh: &'a Mesh,
-    triangles: &'a AliasTable,
+/// An emitter the lanes can sample: an area light and its shape (for a mesh, with its
+/// triangle table).
+pub(super) enum LaneLight<'a> {
+    Mesh {
+        light: &'a AreaLight,
+        mesh: &'a Mesh,
+        triangles: &'a AliasTable,
+    },
+    Sphere {
+        light: &'a AreaLight,
+        sphere: &'a Sphere,
+    },
 }
 
 /// The lane lights, one per emitter, if the scene and strategy are the configuration the
@@ -71,11 +79,12 @@ pub(super) fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<Lane
         .map(|e| match e {
             Emitter::Area(light) => {
                 match (&scene.shapes[light.shape as usize].kind, &light.triangles) {
-                    (ShapeKind::Mesh(mesh), Some(triangles)) => Some(LaneLight {
+                    (ShapeKind::Mesh(mesh), Some(triangles)) => Some(LaneLight::Mesh {
                         light,
                         mesh,
                         triangles,
                     }),
+                    (ShapeKind::Sphere(sphere), _) => Some(LaneLight::Sphere { light, sphere }),
                     _ => None,
                 }
             }
@@ -101,7 +110,19 @@ struct CameraHits {
     l: [Option<Rgb>; LANES],
 }
 
-/// The light triangle of each lane and its data, gathered with scalar table lookups.
+/// The lanes whose light is a sphere, and their spheres. Kept out of `LightDraws`: with these
+/// fields it grew past what LLVM zeroes inline and became a memset call per batch.
+#[derive(Default)]
+struct SphereDraws {
+    any: bool,
+    sphere: [bool; LANES],
+    center: V3x8,
+    radius: [f32; LANES],
+    flip: [bool; LANES],
+}
+
+/// The light triangle of each lane and its data, gathered with scalar table lookups (for a
+/// sphere light, only `shape`, `radiance`, `area` and `pmf`).
 #[derive(Default)]
 struct LightDraws {
     v: [V3x8; 3],
@@ -145,9 +166,14 @@ impl Direct<'_> {
         // The seven numbers `li` draws after the camera's: light (emitter, triangle, point),
         // then BSDF (lobe, direction).
         let u: [[f32; LANES]; 7] = std::array::from_fn(|_| rng.next_f32());
-        let draws = self.light_draws(lights, &u[0], &u[1]);
-        let shaded = self.shade(&hits, &draws, &u);
-        self.trace_and_sum(&hits, &shaded, &mut out);
+        // Filled in place: returned by value, the draws were copied (a 1 kB memcpy).
+        let (mut draws, mut spheres) = (LightDraws::default(), SphereDraws::default());
+        self.light_draws(lights, &u[0], &u[1], &mut draws, &mut spheres);
+        // Sphere lights take a branch per lane, which the mesh-only loop is spared.
+        match spheres.any {
+            false => self.shade_and_trace::<false>(&hits, &draws, &spheres, &u, &mut out),
+            true => self.shade_and_trace_spheres(&hits, &draws, &spheres, &u, &mut out),
+        }
         out
     }
 
@@ -210,17 +236,31 @@ impl Direct<'_> {
         lights: &[LaneLight],
         u_emitter: &[f32; LANES],
         u_tri: &[f32; LANES],
-    ) -> LightDraws {
-        let mut d = LightDraws::default();
+        d: &mut LightDraws,
+        spheres: &mut SphereDraws,
+    ) {
         for i in 0..LANES {
             let Some((e, pmf)) = self.selector.sample(u_emitter[i]) else {
                 continue;
             };
-            let LaneLight {
-                light,
-                mesh,
-                triangles,
-            } = &lights[e];
+            let (light, mesh, triangles) = match &lights[e] {
+                LaneLight::Mesh {
+                    light,
+                    mesh,
+                    triangles,
+                } => (light, mesh, triangles),
+                LaneLight::Sphere { light, sphere } => {
+                    (spheres.sphere[i], spheres.any) = (true, true);
+                    spheres.center.set(i, sphere.center);
+                    spheres.radius[i] = sphere.radius;
+                    spheres.flip[i] = sphere.flip_normals;
+                    d.shape[i] = light.shape;
+                    d.radiance.set(i, light.radiance);
+                    d.area[i] = light.area;
+                    d.pmf[i] = pmf;
+                    continue;
+                }
+            };
             let tri = triangles.sample(u_tri[i]);
             let (ng, err) = mesh.face(tri);
             for (k, v) in mesh.vertices(tri).into_iter().enumerate() {
@@ -239,13 +279,47 @@ impl Direct<'_> {
             d.area[i] = light.area;
             d.pmf[i] = pmf;
         }
-        d
+    }
+
+    /// `shade` and `trace_and_sum`. Each branch of `li_lanes` runs both, so that no
+    /// `Shaded` is returned through the branch: that copy cost the Cornell box 2-5 %.
+    #[inline(always)]
+    fn shade_and_trace<const SPHERES: bool>(
+        &self,
+        h: &CameraHits,
+        ld: &LightDraws,
+        sd: &SphereDraws,
+        u: &[[f32; LANES]; 7],
+        out: &mut [Rgb; LANES],
+    ) {
+        let shaded = self.shade::<SPHERES>(h, ld, sd, u);
+        self.trace_and_sum(h, &shaded, out);
+    }
+
+    /// `shade_and_trace` for batches with a sphere light, out of line: the mesh-only kernel
+    /// then compiles as it would without sphere lights.
+    #[inline(never)]
+    fn shade_and_trace_spheres(
+        &self,
+        h: &CameraHits,
+        ld: &LightDraws,
+        sd: &SphereDraws,
+        u: &[[f32; LANES]; 7],
+        out: &mut [Rgb; LANES],
+    ) {
+        self.shade_and_trace::<true>(h, ld, sd, u, out)
     }
 
     /// The arithmetic of `light_draw`, `light_finish` and `bsdf_draw` and the rays of the two
     /// samples, for all lanes at once (lanes without a covered hit compute garbage, dropped).
     #[inline(always)]
-    fn shade(&self, h: &CameraHits, ld: &LightDraws, u: &[[f32; LANES]; 7]) -> Shaded {
+    fn shade<const SPHERES: bool>(
+        &self,
+        h: &CameraHits,
+        ld: &LightDraws,
+        sd: &SphereDraws,
+        u: &[[f32; LANES]; 7],
+    ) -> Shaded {
         let s = &self.strategy;
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
         let mut o = Shaded::default();
@@ -256,13 +330,26 @@ impl Direct<'_> {
             let diffuse = Diffuse {
                 reflectance: h.reflectance.get(i),
             };
-            // Light sample: the mesh branch of `AreaLight::sample`.
-            let b = square_to_uniform_triangle(Vec2::new(u[2][i], u[3][i]));
-            let v = [ld.v[0].get(i), ld.v[1].get(i), ld.v[2].get(i)];
-            let normals = [ld.n[0].get(i), ld.n[1].get(i), ld.n[2].get(i)];
-            let face = (ld.ng.get(i), ld.err.get(i));
-            let normals = ld.has_normals[i].then_some(normals);
-            let lsp = Mesh::point_from(v, face, normals, b, ld.shape[i], ld.tri[i]);
+            // Light sample: the area-sampling branches of `AreaLight::sample`.
+            let u_point = Vec2::new(u[2][i], u[3][i]);
+            let lsp = if SPHERES && sd.sphere[i] {
+                let s = Sphere {
+                    center: sd.center.get(i),
+                    radius: sd.radius[i],
+                    flip_normals: sd.flip[i],
+                };
+                s.surface_point(
+                    s.center + square_to_uniform_sphere(u_point) * s.radius,
+                    ld.shape[i],
+                )
+            } else {
+                let b = square_to_uniform_triangle(u_point);
+                let v = [ld.v[0].get(i), ld.v[1].get(i), ld.v[2].get(i)];
+                let normals = [ld.n[0].get(i), ld.n[1].get(i), ld.n[2].get(i)];
+                let face = (ld.ng.get(i), ld.err.get(i));
+                let normals = ld.has_normals[i].then_some(normals);
+                Mesh::point_from(v, face, normals, b, ld.shape[i], ld.tri[i])
+            };
             let area = ld.area[i];
             let ls = sample_at(ld.radiance.get(i), p, &lsp, |wi, dist| {
                 area_pdf_along(area, &lsp, wi, dist)
