@@ -187,7 +187,7 @@ fn beckmann_newton_iterations() {
 }
 
 /// The slope inversion against plain bisection of the same CDF (80 halvings), from normal to
-/// grazing incidence and into both tails: the two roots agree to 1e-9 (1 + |x|), a thousandth
+/// grazing incidence and into both tails: the two roots agree to 1e-9 (1 + |x|), 1/60
 /// of the f32 resolution of the normal the slope becomes.
 #[test]
 fn beckmann_slope_inversion_matches_bisection() {
