@@ -139,8 +139,9 @@ fn throughputs(
     let (w, h) = (scene.camera.width, scene.camera.height);
     let samples = w as f64 * h as f64 * spp as f64;
     let mut best: Vec<Option<Timed>> = vec![None; threads.len()];
+    let mut slowest = vec![f64::INFINITY; threads.len()];
     for _ in 0..repeat.max(1) {
-        for (b, &t) in best.iter_mut().zip(threads) {
+        for ((b, slow), &t) in best.iter_mut().zip(&mut slowest).zip(threads) {
             let settings = RenderSettings {
                 spp,
                 seed: 1,
@@ -148,25 +149,24 @@ fn throughputs(
                 progress: false,
             };
             let out = render(scene, strategy, &settings);
-            let timed = Timed {
-                samples_per_s: samples / out.seconds,
-                busy: out.busy_seconds / (out.seconds * t as f64),
-                work_per_sample: out.busy_seconds / samples,
-                slowest_samples_per_s: samples / out.seconds,
-            };
-            let slowest = b.map_or(timed.samples_per_s, |b| {
-                b.slowest_samples_per_s.min(timed.samples_per_s)
-            });
-            if b.is_none_or(|b| timed.samples_per_s > b.samples_per_s) {
-                *b = Some(timed);
-            }
-            if let Some(b) = b {
-                b.slowest_samples_per_s = slowest;
+            let samples_per_s = samples / out.seconds;
+            *slow = slow.min(samples_per_s);
+            if b.is_none_or(|b| samples_per_s > b.samples_per_s) {
+                *b = Some(Timed {
+                    samples_per_s,
+                    busy: out.busy_seconds / (out.seconds * t as f64),
+                    work_per_sample: out.busy_seconds / samples,
+                    slowest_samples_per_s: samples_per_s,
+                });
             }
         }
     }
     best.into_iter()
-        .map(|b| b.expect("at least one repetition"))
+        .zip(slowest)
+        .map(|(b, slowest_samples_per_s)| Timed {
+            slowest_samples_per_s,
+            ..b.expect("at least one repetition")
+        })
         .collect()
 }
 
