@@ -71,6 +71,13 @@ pub(crate) fn sample_at(
     })
 }
 
+/// Area sampling of a sphere light: a uniformly distributed point on the sphere (shared by
+/// `AreaLight::sample` and the lane kernel, so both make the same point).
+#[inline]
+pub(crate) fn sphere_area_point(s: &Sphere, u: Vec2, shape: u32) -> SurfacePoint {
+    s.surface_point(s.center + square_to_uniform_sphere(u) * s.radius, shape)
+}
+
 /// Whether a sphere is sampled by its visible cone from `ref_p`: only from outside, and only
 /// for outward normals (from inside, every direction hits it and area sampling is used).
 /// Returns 1 - cos(theta_max) as sin^2 / (1 + cos): from 1e3 radii away the f32 difference
@@ -108,17 +115,6 @@ impl AreaLight {
         area_pdf_along(self.area, sp, wi, dist)
     }
 
-    /// `sample_at` with this light's radiance.
-    #[inline]
-    fn make_sample(
-        &self,
-        ref_p: Vec3,
-        sp: &SurfacePoint,
-        pdf: impl FnOnce(Vec3, f32) -> f32,
-    ) -> Option<LightSample> {
-        sample_at(self.radiance, ref_p, sp, pdf)
-    }
-
     pub fn sample(
         &self,
         shapes: &[Shape],
@@ -144,12 +140,11 @@ impl AreaLight {
                     let b = to_c.dot(wi);
                     let disc = (s.radius * s.radius - (to_c - b * wi).length_squared()).max(0.0);
                     let sp = s.surface_point(ref_p + wi * (b - disc.sqrt()), self.shape);
-                    return self.make_sample(ref_p, &sp, |_, _| 1.0 / (2.0 * PI * one_minus));
+                    return sample_at(self.radiance, ref_p, &sp, |_, _| {
+                        1.0 / (2.0 * PI * one_minus)
+                    });
                 }
-                s.surface_point(
-                    s.center + square_to_uniform_sphere(u) * s.radius,
-                    self.shape,
-                )
+                sphere_area_point(s, u, self.shape)
             }
             ShapeKind::Mesh(m) => {
                 let table = self.triangles.as_ref()?;
@@ -159,13 +154,15 @@ impl AreaLight {
                     if let Some((w, pdf)) = sample_spherical_triangle(ref_p, v, u) {
                         let sp =
                             m.surface_point(tri, ray_plane_barycentrics(ref_p, w, v)?, self.shape);
-                        return self.make_sample(ref_p, &sp, |_, _| table.pmf(tri) * pdf);
+                        return sample_at(self.radiance, ref_p, &sp, |_, _| table.pmf(tri) * pdf);
                     }
                 }
                 m.surface_point(tri, square_to_uniform_triangle(u), self.shape)
             }
         };
-        self.make_sample(ref_p, &sp, |wi, dist| self.area_pdf_along(&sp, wi, dist))
+        sample_at(self.radiance, ref_p, &sp, |wi, dist| {
+            self.area_pdf_along(&sp, wi, dist)
+        })
     }
 
     /// The density `sample` has for the light point `sp`; it must make the same choices

@@ -4,7 +4,7 @@ mod area;
 mod select;
 
 pub use area::AreaLight;
-pub(crate) use area::{area_pdf_along, sample_at};
+pub(crate) use area::{area_pdf_along, sample_at, sphere_area_point};
 pub use select::{EmitterSelection, EmitterSelector};
 
 use crate::geometry::{Shape, SurfacePoint};

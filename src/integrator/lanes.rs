@@ -18,11 +18,13 @@
 use super::direct::{heuristic, Direct};
 use super::Strategy;
 use crate::bsdf::{BsdfKind, BsdfSample, Diffuse};
-use crate::emitter::{area_pdf_along, sample_at, AreaLight, Emitter, LightSampling};
+use crate::emitter::{
+    area_pdf_along, sample_at, sphere_area_point, AreaLight, Emitter, LightSampling,
+};
 use crate::geometry::{Mesh, Ray, ShapeKind, Sphere, NO_SKIP};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
-use crate::sampling::warps::{square_to_uniform_sphere, square_to_uniform_triangle};
+use crate::sampling::warps::square_to_uniform_triangle;
 use crate::sampling::AliasTable;
 use crate::scene::desc::StrategyKind;
 use crate::scene::Scene;
@@ -338,10 +340,7 @@ impl Direct<'_> {
                     radius: sd.radius[i],
                     flip_normals: sd.flip[i],
                 };
-                s.surface_point(
-                    s.center + square_to_uniform_sphere(u_point) * s.radius,
-                    ld.shape[i],
-                )
+                sphere_area_point(&s, u_point, ld.shape[i])
             } else {
                 let b = square_to_uniform_triangle(u_point);
                 let v = [ld.v[0].get(i), ld.v[1].get(i), ld.v[2].get(i)];
