@@ -49,6 +49,11 @@ pub fn fresnel_conductor(cos_i: f32, eta: Rgb, k: Rgb) -> Rgb {
         };
         (0.5 * (rs + rp)) as f32
     };
+    // Grey indices (Mitsuba's default "none" material among them) need one channel, not
+    // three: the f64 square roots and divisions are most of a rough conductor's eval.
+    if eta.x == eta.y && eta.x == eta.z && k.x == k.y && k.x == k.z {
+        return Rgb::splat(one(eta.x, k.x));
+    }
     Rgb::new(one(eta.x, k.x), one(eta.y, k.y), one(eta.z, k.z))
 }
 
@@ -132,6 +137,21 @@ mod tests {
                     .max_element()
                     < 1e-6
             );
+        }
+    }
+
+    /// The grey shortcut is the per-channel formula, bit for bit: each channel of a coloured
+    /// index equals the grey index made of that channel.
+    #[test]
+    fn conductor_grey_shortcut_matches_each_channel() {
+        let (eta, k) = (Rgb::new(0.2, 0.92, 1.1), Rgb::new(3.9, 2.45, 2.14));
+        for i in 0..=200 {
+            let c = i as f32 / 200.0;
+            let f = fresnel_conductor(c, eta, k);
+            for ch in 0..3 {
+                let grey = fresnel_conductor(c, Rgb::splat(eta[ch]), Rgb::splat(k[ch]));
+                assert_eq!(grey, Rgb::splat(f[ch]), "cos {c}, channel {ch}");
+            }
         }
     }
 }

@@ -10,7 +10,7 @@
 //! Both samplers work in slope space: m = normalize(-x, -y, 1) and D(m) cos(theta_m) dω equals
 //! the slope density P22(x, y) dx dy; stretching slopes by (alpha_u, alpha_v) gives anisotropy.
 
-use super::erf::{erfc, erfinv, erfinv_approx};
+use super::erf::{erfc_from_exp, erfinv, erfinv_approx};
 pub use crate::scene::desc::MicrofacetDistribution;
 use glam::{DVec3, Vec2, Vec3};
 use std::f64::consts::PI;
@@ -76,7 +76,8 @@ impl Microfacet {
                 if a > 6.0 {
                     0.0
                 } else {
-                    0.5 * ((-a * a).exp() / (a * PI.sqrt()) - erfc(a))
+                    let e = (-a * a).exp();
+                    0.5 * (e / (a * PI.sqrt()) - erfc_from_exp(a, e))
                 }
             }
         };
@@ -188,13 +189,14 @@ thread_local!(pub static ITERS: std::cell::Cell<u64> = const { std::cell::Cell::
 /// for no visible digit).
 fn beckmann_visible_slope(tan_t: f64, u: f64) -> f64 {
     let k = tan_t / PI.sqrt();
-    // C(x) from exp(-x^2), which the Newton step's derivative reuses.
-    let cdf = |x: f64, e: f64| erfc(-x) + k * e;
+    // C(x) from exp(-x^2), which erfc and the Newton step's derivative share.
+    let cdf = |x: f64, e: f64| erfc_from_exp(-x, e) + k * e;
     // Beyond |x| = 9 both terms are below 1e-35 of the total: nothing left to sample.
     let (mut lo, mut hi) = (-9.0f64, if tan_t > 1.0 / 9.0 { 1.0 / tan_t } else { 9.0 });
     // hi > 0, so erfc(-hi) is exactly 2 - erfc(hi) (that is how `erfc` makes it).
-    let erfc_hi = erfc(hi);
-    let target = u.clamp(1e-12, 1.0 - 1e-12) * ((2.0 - erfc_hi) + k * (-hi * hi).exp());
+    let e_hi = (-hi * hi).exp();
+    let erfc_hi = erfc_from_exp(hi, e_hi);
+    let target = u.clamp(1e-12, 1.0 - 1e-12) * ((2.0 - erfc_hi) + k * e_hi);
     // Mitsuba 3's starting guess, in erf space: a power of 1 - u fitted in theta.
     let c = 1.0 - erfc_hi;
     let theta = tan_t.atan();
