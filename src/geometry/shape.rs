@@ -56,7 +56,8 @@ impl Mesh {
                 let n = (b - a).cross(c - a).normalize_or_zero();
                 (n, a.abs().max(b.abs()).max(c.abs()))
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let normals = normals.filter(|ns| !all_flat(ns, &indices, &face));
         Mesh {
             positions,
             normals,
@@ -194,9 +195,48 @@ pub fn intersect_sphere(o: Vec3, d: Vec3, tmin: f32, tmax: f32, c: Vec3, r: f32)
     }
 }
 
+/// Whether every triangle's vertex normals are its face normal (to 1e-5 per component, f32
+/// rounding of a transformed normal): flat shapes such as Mitsuba's rectangle and cube, or an
+/// OBJ exported with flat normals. Such normals shade as the face normal does, so `Mesh::new`
+/// drops them and every hit is spared an interpolation and a normalisation.
+fn all_flat(normals: &[Vec3], indices: &[[u32; 3]], face: &[(Vec3, Vec3)]) -> bool {
+    indices.iter().zip(face).all(|(t, (ng, _))| {
+        t.iter().all(|&i| {
+            let n = normals[i as usize].normalize_or_zero();
+            (n - *ng).abs().max_element() < 1e-5
+        })
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Vertex normals equal to the face normals are dropped; any that bend the shading (a
+    /// smooth mesh, normals flipped against the winding, one tilted vertex) are kept.
+    #[test]
+    fn flat_vertex_normals_are_dropped_and_others_kept() {
+        let p = vec![Vec3::ZERO, Vec3::X * 2.0, Vec3::Y * 3.0];
+        let with = |n: [Vec3; 3]| Mesh::new(p.clone(), Some(n.to_vec()), vec![[0, 1, 2]]);
+        assert!(with([Vec3::Z * 4.0; 3]).normals.is_none());
+        assert!(with([-Vec3::Z; 3]).normals.is_some());
+        let tilted = Vec3::new(1e-3, 0.0, 1.0);
+        assert!(with([Vec3::Z, Vec3::Z, tilted]).normals.is_some());
+        // A rectangle through a rotation keeps flat normals flat.
+        let r = glam::Quat::from_rotation_x(-0.9);
+        let q = [
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+        ];
+        let m = Mesh::new(
+            q.map(|v| r * v).to_vec(),
+            Some(vec![r * Vec3::Z; 3]),
+            vec![[0, 1, 2]],
+        );
+        assert!(m.normals.is_none());
+        assert!((m.surface_point(0, Vec2::new(0.2, 0.3), 0).ns - r * Vec3::Z).length() < 1e-6);
+    }
 
     #[test]
     fn sphere_hits_front_then_back() {
