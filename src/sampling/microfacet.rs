@@ -166,9 +166,10 @@ impl Microfacet {
         } else {
             (1.0, 0.0)
         };
-        let x = beckmann_visible_slope(tan_t, u.x as f64);
-        // The y marginal is Gaussian (variance 1/2): a plain inverse erf.
+        // The y marginal is Gaussian (variance 1/2): a plain inverse erf. Computed first, its
+        // dependency chain overlaps the slope inversion's instead of following it.
         let y = erfinv(2.0 * (u.y as f64).clamp(1e-12, 1.0 - 1e-12) - 1.0);
+        let x = beckmann_visible_slope(tan_t, u.x as f64);
         let sx = (cp * x - sp * y) * au;
         let sy = (sp * x + cp * y) * av;
         DVec3::new(-sx, -sy, 1.0).normalize().as_vec3()
