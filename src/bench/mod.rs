@@ -170,15 +170,17 @@ fn throughputs(
         .collect()
 }
 
-/// Nanoseconds per emitter choice (one uniform number in, emitter and pmf out), best of 7
-/// runs of 2^22 choices (10 ms each; best of 3 once read 3.8 ns for a table that costs 2.4).
-/// The numbers jump around the unit interval (golden-ratio sequence) as a render's do, so
-/// table lookups are not sequential.
-fn choice_ns(scene: &crate::scene::Scene, sel: EmitterSelection) -> f64 {
-    let selector = crate::emitter::EmitterSelector::new(&scene.emitters, sel);
+/// Nanoseconds per emitter choice (one uniform number in, emitter and pmf out) of each
+/// selector, best of 7 runs of 2^22 choices (10 ms each). The selectors take turns, run by
+/// run: timed one selector after another, all seven runs of a count fitted inside one slow
+/// spell of this VM, and in two bench runs one count read 2.0 ns where the others read 1.3
+/// (best of 3 once read 3.8 ns for a table that costs 2.4). The numbers jump around the unit
+/// interval (golden-ratio sequence) as a render's do, so table lookups are not sequential.
+fn choice_ns(selectors: &[crate::emitter::EmitterSelector]) -> Vec<f64> {
     let n = 1u32 << 22;
-    (0..7)
-        .map(|_| {
+    let mut best = vec![f64::INFINITY; selectors.len()];
+    for _ in 0..7 {
+        for (selector, best) in selectors.iter().zip(&mut best) {
             let start = std::time::Instant::now();
             let mut sink = 0usize;
             for i in 0..n {
@@ -188,9 +190,10 @@ fn choice_ns(scene: &crate::scene::Scene, sel: EmitterSelection) -> f64 {
                 }
             }
             std::hint::black_box(sink);
-            start.elapsed().as_secs_f64() * 1e9 / n as f64
-        })
-        .fold(f64::INFINITY, f64::min)
+            *best = best.min(start.elapsed().as_secs_f64() * 1e9 / n as f64);
+        }
+    }
+    best
 }
 
 /// Peak resident memory of this process in bytes (Linux), if known.
@@ -387,6 +390,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             selection: sel,
             ..mis
         };
+        let (mut counts, mut selectors) = (Vec::new(), Vec::new());
         for n in [1usize, 10, 100, 1_000, 10_000] {
             if n > a.max_emitters {
                 break;
@@ -409,9 +413,12 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                 value: 1e9 / sps,
                 unit: "ns/sample",
             });
-            // The choice alone: the render's cost above also grows with the BVH (n lights are
-            // 2n more triangles), which is not the selector's doing.
-            let ns = choice_ns(&scene, sel);
+            // The choice alone, timed below: the render's cost above also grows with the BVH
+            // (n lights are 2n more triangles), which is not the selector's doing.
+            counts.push(n);
+            selectors.push(crate::emitter::EmitterSelector::new(&scene.emitters, sel));
+        }
+        for (n, ns) in counts.into_iter().zip(choice_ns(&selectors)) {
             println!(
                 "  {:>9} emitters ({:?} choice alone): {:>8.2} ns/choice",
                 n, sel, ns
