@@ -112,15 +112,12 @@ struct CameraHits {
     l: [Option<Rgb>; LANES],
 }
 
-/// The lanes whose light is a sphere, and their spheres. Kept out of `LightDraws`: with these
+/// The sphere of each lane whose light is a sphere. Kept out of `LightDraws`: with these
 /// fields it grew past what LLVM zeroes inline and became a memset call per batch.
 #[derive(Default)]
 struct SphereDraws {
     any: bool,
-    sphere: [bool; LANES],
-    center: V3x8,
-    radius: [f32; LANES],
-    flip: [bool; LANES],
+    sphere: [Option<Sphere>; LANES],
 }
 
 /// The light triangle of each lane and its data, gathered with scalar table lookups (for a
@@ -245,21 +242,17 @@ impl Direct<'_> {
             let Some((e, pmf)) = self.selector.sample(u_emitter[i]) else {
                 continue;
             };
-            let (light, mesh, triangles) = match &lights[e] {
+            let (LaneLight::Mesh { light, .. } | LaneLight::Sphere { light, .. }) = &lights[e];
+            d.shape[i] = light.shape;
+            d.radiance.set(i, light.radiance);
+            d.area[i] = light.area;
+            d.pmf[i] = pmf;
+            let (mesh, triangles) = match &lights[e] {
                 LaneLight::Mesh {
-                    light,
-                    mesh,
-                    triangles,
-                } => (light, mesh, triangles),
-                LaneLight::Sphere { light, sphere } => {
-                    (spheres.sphere[i], spheres.any) = (true, true);
-                    spheres.center.set(i, sphere.center);
-                    spheres.radius[i] = sphere.radius;
-                    spheres.flip[i] = sphere.flip_normals;
-                    d.shape[i] = light.shape;
-                    d.radiance.set(i, light.radiance);
-                    d.area[i] = light.area;
-                    d.pmf[i] = pmf;
+                    mesh, triangles, ..
+                } => (mesh, triangles),
+                LaneLight::Sphere { sphere, .. } => {
+                    (spheres.sphere[i], spheres.any) = (Some(**sphere), true);
                     continue;
                 }
             };
@@ -276,10 +269,7 @@ impl Direct<'_> {
             }
             d.ng.set(i, ng);
             d.err.set(i, err);
-            (d.shape[i], d.tri[i]) = (light.shape, tri as u32);
-            d.radiance.set(i, light.radiance);
-            d.area[i] = light.area;
-            d.pmf[i] = pmf;
+            d.tri[i] = tri as u32;
         }
     }
 
@@ -334,12 +324,8 @@ impl Direct<'_> {
             };
             // Light sample: the area-sampling branches of `AreaLight::sample`.
             let u_point = Vec2::new(u[2][i], u[3][i]);
-            let lsp = if SPHERES && sd.sphere[i] {
-                let s = Sphere {
-                    center: sd.center.get(i),
-                    radius: sd.radius[i],
-                    flip_normals: sd.flip[i],
-                };
+            let sphere = if SPHERES { sd.sphere[i] } else { None };
+            let lsp = if let Some(s) = sphere {
                 sphere_area_point(&s, u_point, ld.shape[i])
             } else {
                 let b = square_to_uniform_triangle(u_point);
