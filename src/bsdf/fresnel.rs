@@ -30,31 +30,40 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> (f32, f32, f32) {
 /// (Mitsuba's `fresnel_conductor`, the closed form of the complex-amplitude expression).
 #[inline]
 pub fn fresnel_conductor(cos_i: f32, eta: Rgb, k: Rgb) -> Rgb {
-    let c = cos_i.clamp(0.0, 1.0) as f64;
-    let one = |eta: f32, k: f32| -> f32 {
-        let (eta, k) = (eta as f64, k as f64);
-        let c2 = c * c;
-        let s2 = 1.0 - c2;
-        let t1 = eta * eta - k * k - s2;
-        let a2b2 = (t1 * t1 + 4.0 * eta * eta * k * k).max(0.0).sqrt();
-        let a = (0.5 * (a2b2 + t1)).max(0.0).sqrt();
-        let (t_1, t_2) = (a2b2 + c2, 2.0 * c * a);
-        let rs = (t_1 - t_2) / (t_1 + t_2);
-        let (t_3, t_4) = (a2b2 * c2 + s2 * s2, t_2 * s2);
-        // eta = k = 0 at normal incidence is 0/0 in r_p; its limit equals r_s.
-        let rp = if t_3 + t_4 > 0.0 {
-            rs * (t_3 - t_4) / (t_3 + t_4)
-        } else {
-            rs
-        };
-        (0.5 * (rs + rp)) as f32
-    };
+    let one = |eta, k| fresnel_conductor_channel(cos_i, eta, k);
     // Grey indices (Mitsuba's default "none" material among them) need one channel, not
     // three: the f64 square roots and divisions are most of a rough conductor's eval.
-    if eta.x == eta.y && eta.x == eta.z && k.x == k.y && k.x == k.z {
+    if is_grey(eta, k) {
         return Rgb::splat(one(eta.x, k.x));
     }
     Rgb::new(one(eta.x, k.x), one(eta.y, k.y), one(eta.z, k.z))
+}
+
+/// Whether every channel of the index is the same, so that one channel is the whole
+/// `fresnel_conductor`.
+#[inline]
+pub fn is_grey(eta: Rgb, k: Rgb) -> bool {
+    eta.x == eta.y && eta.x == eta.z && k.x == k.y && k.x == k.z
+}
+
+/// One channel of `fresnel_conductor`; selects rather than branches, so that it runs in
+/// vector lanes (`integrator::lanes`).
+#[inline(always)]
+pub fn fresnel_conductor_channel(cos_i: f32, eta: f32, k: f32) -> f32 {
+    let c = cos_i.clamp(0.0, 1.0) as f64;
+    let (eta, k) = (eta as f64, k as f64);
+    let c2 = c * c;
+    let s2 = 1.0 - c2;
+    let t1 = eta * eta - k * k - s2;
+    let a2b2 = (t1 * t1 + 4.0 * eta * eta * k * k).max(0.0).sqrt();
+    let a = (0.5 * (a2b2 + t1)).max(0.0).sqrt();
+    let (t_1, t_2) = (a2b2 + c2, 2.0 * c * a);
+    let rs = (t_1 - t_2) / (t_1 + t_2);
+    let (t_3, t_4) = (a2b2 * c2 + s2 * s2, t_2 * s2);
+    // eta = k = 0 at normal incidence is 0/0 in r_p; its limit equals r_s.
+    let rp_full = rs * (t_3 - t_4) / (t_3 + t_4);
+    let rp = if t_3 + t_4 > 0.0 { rp_full } else { rs };
+    (0.5 * (rs + rp)) as f32
 }
 
 #[cfg(test)]

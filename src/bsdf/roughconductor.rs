@@ -55,9 +55,23 @@ impl RoughConductor {
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return (Rgb::ZERO, 0.0);
         }
+        self.eval_pdf_with(wi, wo, self.mf.lambda(wi), |c| self.fresnel(c))
+    }
+
+    /// `eval_pdf` given Smith's Lambda(wi), which a shading point computes once for all its
+    /// samples, and the Fresnel term times specular_reflectance. Selects rather than early
+    /// returns, so that `integrator::lanes` runs it in vector lanes.
+    #[inline(always)]
+    pub(crate) fn eval_pdf_with(
+        &self,
+        wi: Vec3,
+        wo: Vec3,
+        lambda_i: f32,
+        fresnel: impl Fn(f32) -> Rgb,
+    ) -> (Rgb, f32) {
         let h = Self::half(wi, wo);
         let d = self.mf.d(h);
-        let g1_i = self.mf.g1(wi, h);
+        let g1_i = self.mf.g1_given(wi, h, lambda_i);
         let pdf = if self.sample_visible {
             // G1 (wi.h) D / cos_i over the reflection Jacobian 4 (wo.h): the dot products are
             // equal in exact arithmetic, but f32 unit vectors are not exactly unit, and at
@@ -66,12 +80,16 @@ impl RoughConductor {
         } else {
             self.mf.pdf_all(h) / (4.0 * wo.dot(h))
         };
-        if d == 0.0 {
-            return (Rgb::ZERO, pdf);
-        }
         // Separable Smith shadowing-masking, as Mitsuba's microfacet plugins.
         let g = g1_i * self.mf.g1(wo, h);
-        (self.fresnel(wi.dot(h)) * (d * g / (4.0 * wi.z)), pdf)
+        let f = fresnel(wi.dot(h)) * (d * g / (4.0 * wi.z));
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            (Rgb::ZERO, 0.0)
+        } else if d == 0.0 {
+            (Rgb::ZERO, pdf)
+        } else {
+            (f, pdf)
+        }
     }
 
     #[inline]
@@ -84,22 +102,26 @@ impl RoughConductor {
         } else {
             self.mf.sample_all(u)
         };
+        self.reflect(wi, m, self.mf.lambda(wi), |c| self.fresnel(c))
+    }
+
+    /// The sample that reflects wi (wi.z > 0) about the microfacet normal m, given Lambda(wi)
+    /// and the Fresnel term (as `eval_pdf_with`); None below the horizon.
+    #[inline(always)]
+    pub(crate) fn reflect(
+        &self,
+        wi: Vec3,
+        m: Vec3,
+        lambda_i: f32,
+        fresnel: impl Fn(f32) -> Rgb,
+    ) -> Option<BsdfSample> {
         let wi_m = wi.dot(m);
-        if wi_m <= 0.0 {
-            return None;
-        }
         let wo = (2.0 * wi_m * m - wi).normalize();
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let (f, pdf) = self.eval_pdf(wi, wo);
-        if !(pdf > 0.0) {
-            return None;
-        }
-        let weight = f / pdf;
-        Some(BsdfSample {
+        let (f, pdf) = self.eval_pdf_with(wi, wo, lambda_i, fresnel);
+        let ok = wi_m > 0.0 && wo.z > 0.0 && pdf > 0.0;
+        ok.then(|| BsdfSample {
             wo,
-            weight,
+            weight: f / pdf,
             pdf,
             delta: false,
         })

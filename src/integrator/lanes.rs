@@ -17,13 +17,15 @@
 
 use super::direct::{heuristic, Direct};
 use super::Strategy;
-use crate::bsdf::{BsdfKind, BsdfSample, Diffuse};
+use crate::bsdf::fresnel::is_grey;
+use crate::bsdf::{BsdfKind, BsdfSample, Diffuse, RoughConductor};
 use crate::emitter::{
     area_pdf_along, sample_at, sphere_area_point, AreaLight, Emitter, LightSampling,
 };
-use crate::geometry::{Mesh, Ray, ShapeKind, Sphere, NO_SKIP};
+use crate::geometry::{Mesh, Ray, ShapeKind, Sphere, SurfacePoint, NO_SKIP};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
+use crate::sampling::microfacet::MicrofacetDistribution;
 use crate::sampling::warps::square_to_uniform_triangle;
 use crate::sampling::AliasTable;
 use crate::scene::desc::StrategyKind;
@@ -32,7 +34,7 @@ use glam::{Vec2, Vec3};
 
 /// Eight 3-vectors, one array per component.
 #[derive(Clone, Copy, Default)]
-struct V3x8 {
+pub(super) struct V3x8 {
     x: [f32; LANES],
     y: [f32; LANES],
     z: [f32; LANES],
@@ -40,12 +42,12 @@ struct V3x8 {
 
 impl V3x8 {
     #[inline(always)]
-    fn get(&self, i: usize) -> Vec3 {
+    pub(super) fn get(&self, i: usize) -> Vec3 {
         Vec3::new(self.x[i], self.y[i], self.z[i])
     }
 
     #[inline(always)]
-    fn set(&mut self, i: usize, v: Vec3) {
+    pub(super) fn set(&mut self, i: usize, v: Vec3) {
         (self.x[i], self.y[i], self.z[i]) = (v.x, v.y, v.z);
     }
 }
@@ -97,14 +99,22 @@ pub(super) fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<Lane
 
 /// What the camera hits of the eight samples leave for shading.
 #[derive(Default)]
-struct CameraHits {
-    p: V3x8,
-    ng: V3x8,
-    ns: V3x8,
-    err: V3x8,
+pub(super) struct CameraHits {
+    pub(super) p: V3x8,
+    pub(super) ng: V3x8,
+    pub(super) ns: V3x8,
+    pub(super) err: V3x8,
     /// Camera ray direction.
-    d: V3x8,
-    reflectance: V3x8,
+    pub(super) d: V3x8,
+    /// Diffuse reflectance, or a rough conductor's specular reflectance.
+    pub(super) reflectance: V3x8,
+    /// Whether this batch's lanes are rough conductors (`lanes_rough`), else diffuse.
+    pub(super) rough: bool,
+    /// A rough conductor's roughness and its grey complex index of refraction.
+    pub(super) alpha_u: [f32; LANES],
+    pub(super) alpha_v: [f32; LANES],
+    pub(super) eta: [f32; LANES],
+    pub(super) k: [f32; LANES],
     /// Accelerator skip ids of the hit triangle (all rays, emitter-only structure).
     skip: [u32; LANES],
     emitter_skip: [u32; LANES],
@@ -115,7 +125,7 @@ struct CameraHits {
 /// The sphere of each lane whose light is a sphere. Kept out of `LightDraws`: with these
 /// fields it grew past what LLVM zeroes inline and became a memset call per batch.
 #[derive(Default)]
-struct SphereDraws {
+pub(super) struct SphereDraws {
     any: bool,
     sphere: [Option<Sphere>; LANES],
 }
@@ -123,7 +133,7 @@ struct SphereDraws {
 /// The light triangle of each lane and its data, gathered with scalar table lookups (for a
 /// sphere light, only `shape`, `radiance`, `area` and `pmf`).
 #[derive(Default)]
-struct LightDraws {
+pub(super) struct LightDraws {
     v: [V3x8; 3],
     ng: V3x8,
     err: V3x8,
@@ -134,20 +144,21 @@ struct LightDraws {
     tri: [u32; LANES],
     radiance: V3x8,
     area: [f32; LANES],
-    pmf: [f32; LANES],
+    pub(super) pmf: [f32; LANES],
 }
 
 /// The lanes' rays and candidate contributions, before visibility.
 #[derive(Default)]
-struct Shaded {
-    shadow_o: V3x8,
-    shadow_target: V3x8,
-    light: V3x8,
-    light_ok: [bool; LANES],
-    bsdf_o: V3x8,
-    bsdf_d: V3x8,
-    bsdf_pdf: [f32; LANES],
-    bsdf_ok: [bool; LANES],
+pub(super) struct Shaded {
+    pub(super) shadow_o: V3x8,
+    pub(super) shadow_target: V3x8,
+    pub(super) light: V3x8,
+    pub(super) light_ok: [bool; LANES],
+    pub(super) bsdf_o: V3x8,
+    pub(super) bsdf_d: V3x8,
+    pub(super) bsdf_pdf: [f32; LANES],
+    pub(super) bsdf_weight: V3x8,
+    pub(super) bsdf_ok: [bool; LANES],
 }
 
 impl Direct<'_> {
@@ -169,9 +180,10 @@ impl Direct<'_> {
         let (mut draws, mut spheres) = (LightDraws::default(), SphereDraws::default());
         self.light_draws(lights, &u[0], &u[1], &mut draws, &mut spheres);
         // Sphere lights take a branch per lane, which the mesh-only loop is spared.
-        match spheres.any {
-            false => self.shade_and_trace::<false>(&hits, &draws, &spheres, &u, &mut out),
-            true => self.shade_and_trace_spheres(&hits, &draws, &spheres, &u, &mut out),
+        match (hits.rough, spheres.any) {
+            (true, _) => self.shade_and_trace_rough(&hits, &draws, &spheres, &u, &mut out),
+            (false, false) => self.shade_and_trace::<false>(&hits, &draws, &spheres, &u, &mut out),
+            (false, true) => self.shade_and_trace_spheres(&hits, &draws, &spheres, &u, &mut out),
         }
         out
     }
@@ -192,17 +204,30 @@ impl Direct<'_> {
     ) -> CameraHits {
         let scene = self.scene;
         let mut h = CameraHits::default();
+        let mut batch = None;
         for i in 0..n {
             let Some(hit) = scene.intersect(&rays[i]) else {
                 continue;
             };
             let sp = hit.sp;
             let mat = scene.material(&sp);
-            let BsdfKind::Diffuse(diffuse) = &mat.kind else {
-                out[i] = self.li_hit(&rays[i], &sp, &mut rng.lane(i));
-                continue;
+            // The batch takes the kind of its first covered hit; hits of the other kind (at a
+            // pixel straddling two materials) and uncovered materials take the scalar path.
+            let rough = match &mat.kind {
+                _ if mat.two_sided => None,
+                BsdfKind::Diffuse(diffuse) => {
+                    h.reflectance.set(i, diffuse.reflectance);
+                    Some(false)
+                }
+                BsdfKind::RoughConductor(rc) if rough_covered(rc) => {
+                    h.reflectance.set(i, rc.specular_reflectance);
+                    (h.alpha_u[i], h.alpha_v[i]) = (rc.mf.alpha_u, rc.mf.alpha_v);
+                    (h.eta[i], h.k[i]) = (rc.eta.x, rc.k.x);
+                    Some(true)
+                }
+                _ => None,
             };
-            if mat.two_sided {
+            if rough.is_none_or(|r| r != *batch.get_or_insert(r)) {
                 out[i] = self.li_hit(&rays[i], &sp, &mut rng.lane(i));
                 continue;
             }
@@ -218,13 +243,13 @@ impl Direct<'_> {
             h.ns.set(i, sp.ns);
             h.err.set(i, sp.err_scale);
             h.d.set(i, rays[i].d);
-            h.reflectance.set(i, diffuse.reflectance);
             h.skip[i] = scene.accel.skip_id(&sp);
             h.emitter_skip[i] = scene
                 .emitter_accel
                 .as_ref()
                 .map_or(NO_SKIP, |e| e.skip_id(&sp));
         }
+        h.rough = batch == Some(true);
         h
     }
 
@@ -322,27 +347,7 @@ impl Direct<'_> {
             let diffuse = Diffuse {
                 reflectance: h.reflectance.get(i),
             };
-            // Light sample: the area-sampling branches of `AreaLight::sample`.
-            let u_point = Vec2::new(u[2][i], u[3][i]);
-            let sphere = if SPHERES { sd.sphere[i] } else { None };
-            let lsp = if let Some(s) = sphere {
-                sphere_area_point(&s, u_point, ld.shape[i])
-            } else {
-                let b = square_to_uniform_triangle(u_point);
-                let v = [ld.v[0].get(i), ld.v[1].get(i), ld.v[2].get(i)];
-                let normals = [ld.n[0].get(i), ld.n[1].get(i), ld.n[2].get(i)];
-                let face = (ld.ng.get(i), ld.err.get(i));
-                let normals = ld.has_normals[i].then_some(normals);
-                Mesh::point_from(v, face, normals, b, ld.shape[i], ld.tri[i])
-            };
-            let area = ld.area[i];
-            let ls = sample_at(ld.radiance.get(i), p, &lsp, |wi, dist| {
-                area_pdf_along(area, &lsp, wi, dist)
-            });
-            let (drawn, wl, pdf_area, radiance) = match ls {
-                Some(ls) => (true, ls.wi, ls.pdf, ls.li),
-                None => (false, Vec3::ZERO, 0.0, Rgb::ZERO),
-            };
+            let (drawn, wl, pdf_area, radiance, lsp) = light_sample::<SPHERES>(p, ld, sd, u, i);
             // `light_finish` before its visibility test.
             let wo = frame.to_local(wl);
             let (f, pdf_bsdf) = (diffuse.eval(wi, wo), diffuse.pdf(wi, wo));
@@ -363,6 +368,7 @@ impl Direct<'_> {
             };
             o.bsdf_ok[i] = bsdf_ok;
             o.bsdf_pdf[i] = pdf;
+            o.bsdf_weight.set(i, diffuse.reflectance);
             let d = frame.to_world(wo);
             o.bsdf_d.set(i, d);
             o.bsdf_o.set(i, offset_origin(p, ng, err, d));
@@ -373,7 +379,7 @@ impl Direct<'_> {
     /// The traversals, one ray at a time, and the estimate of each covered lane, summed in
     /// `li`'s order.
     #[inline(always)]
-    fn trace_and_sum(&self, h: &CameraHits, sh: &Shaded, out: &mut [Rgb; LANES]) {
+    pub(super) fn trace_and_sum(&self, h: &CameraHits, sh: &Shaded, out: &mut [Rgb; LANES]) {
         let scene = self.scene;
         let s = &self.strategy;
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
@@ -400,7 +406,7 @@ impl Direct<'_> {
                 };
                 let bs = BsdfSample {
                     wo: Vec3::ZERO,
-                    weight: h.reflectance.get(i),
+                    weight: sh.bsdf_weight.get(i),
                     pdf: sh.bsdf_pdf[i],
                     delta: false,
                 };
@@ -410,4 +416,45 @@ impl Direct<'_> {
             out[i] = l;
         }
     }
+}
+
+/// Lane i's light sample: the area-sampling branches of `AreaLight::sample` for the drawn
+/// triangle or sphere, seen from p: whether it was drawn, its direction, its density in
+/// solid angle, its radiance and the light point.
+#[inline(always)]
+pub(super) fn light_sample<const SPHERES: bool>(
+    p: Vec3,
+    ld: &LightDraws,
+    sd: &SphereDraws,
+    u: &[[f32; LANES]; 7],
+    i: usize,
+) -> (bool, Vec3, f32, Rgb, SurfacePoint) {
+    let u_point = Vec2::new(u[2][i], u[3][i]);
+    let sphere = if SPHERES { sd.sphere[i] } else { None };
+    let lsp = if let Some(s) = sphere {
+        sphere_area_point(&s, u_point, ld.shape[i])
+    } else {
+        let b = square_to_uniform_triangle(u_point);
+        let v = [ld.v[0].get(i), ld.v[1].get(i), ld.v[2].get(i)];
+        let normals = [ld.n[0].get(i), ld.n[1].get(i), ld.n[2].get(i)];
+        let face = (ld.ng.get(i), ld.err.get(i));
+        let normals = ld.has_normals[i].then_some(normals);
+        Mesh::point_from(v, face, normals, b, ld.shape[i], ld.tri[i])
+    };
+    let area = ld.area[i];
+    let ls = sample_at(ld.radiance.get(i), p, &lsp, |wi, dist| {
+        area_pdf_along(area, &lsp, wi, dist)
+    });
+    match ls {
+        Some(ls) => (true, ls.wi, ls.pdf, ls.li, lsp),
+        None => (false, Vec3::ZERO, 0.0, Rgb::ZERO, lsp),
+    }
+}
+
+/// Rough conductors the lanes shade (`lanes_rough`): Beckmann with visible-normal sampling
+/// and a grey index (one Fresnel channel), the Veach scene's plates.
+fn rough_covered(rc: &RoughConductor) -> bool {
+    rc.mf.distribution == MicrofacetDistribution::Beckmann
+        && rc.sample_visible
+        && is_grey(rc.eta, rc.k)
 }

@@ -2,6 +2,7 @@
 
 mod direct;
 mod lanes;
+mod lanes_rough;
 mod strategy;
 
 pub use direct::Direct;

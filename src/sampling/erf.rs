@@ -2,11 +2,13 @@
 //! Computed in f64: the sampler inverts a CDF built from `erfc`, so its accuracy sets how
 //! closely the sampled density follows the analytic pdf.
 
+use super::elementary::{exp, ln};
+
 /// Complementary error function, relative error below 1.5e-9 for every x. The renderer
 /// calls `erfc_from_exp`; this and `erf` are the plain forms its tests check against.
 #[cfg(test)]
 pub fn erfc(x: f64) -> f64 {
-    erfc_from_exp(x, (-x * x).exp())
+    erfc_from_exp(x, exp(-x * x))
 }
 
 /// erfc(x) given `e` = exp(-x^2). Callers that need exp(-x^2) anyway (the Beckmann Smith term,
@@ -20,7 +22,7 @@ pub fn erfc(x: f64) -> f64 {
 /// error is 1.41e-9, at z = 0.025. The relative bound matters: Beckmann tails live in
 /// erfc's tail. Evaluated by Estrin's scheme, a shorter dependency chain than Horner's
 /// on the Newton iterations' critical path.
-#[inline]
+#[inline(always)]
 pub fn erfc_from_exp(x: f64, e: f64) -> f64 {
     const C: [f64; 13] = [
         0.510791352413019,
@@ -58,54 +60,49 @@ pub fn erf(x: f64) -> f64 {
 
 /// Inverse of erf on (-1, 1): Giles' 2010 approximation (relative error ~4e-7), then one
 /// Newton step on `erf` so the result is consistent with `erf` itself to ~1e-13.
+#[inline(always)]
 pub fn erfinv(y: f64) -> f64 {
     let x = erfinv_approx(y);
-    let e = (-x * x).exp();
-    let d = 2.0 / std::f64::consts::PI.sqrt() * e;
+    let e = exp(-x * x);
+    let d = std::f64::consts::FRAC_2_SQRT_PI * e;
+    let refined = x - ((1.0 - erfc_from_exp(x, e)) - y) / d;
     if d > 0.0 {
-        x - ((1.0 - erfc_from_exp(x, e)) - y) / d
+        refined
     } else {
         x
     }
 }
 
-/// Giles' single-precision erfinv approximation, for starting guesses.
+/// Giles' single-precision erfinv approximation, for starting guesses. Both of its branches
+/// are evaluated and one is selected, so that it runs in vector lanes.
+#[inline(always)]
 pub fn erfinv_approx(y: f64) -> f64 {
     let y = y.clamp(-1.0 + 1e-15, 1.0 - 1e-15);
-    let mut w = -((1.0 - y) * (1.0 + y)).ln();
-    let p = if w < 5.0 {
-        w -= 2.5;
-        let mut p = 2.810_226_36e-08;
-        for c in [
-            3.432_739_39e-07,
-            -3.523_387_7e-06,
-            -4.391_506_54e-06,
-            0.000_218_580_87,
-            -0.001_253_725_03,
-            -0.004_177_681_64,
-            0.246_640_727,
-            1.501_409_41,
-        ] {
-            p = c + p * w;
-        }
-        p
-    } else {
-        w = w.sqrt() - 3.0;
-        let mut p = -0.000_200_214_257;
-        for c in [
-            0.000_100_950_558,
-            0.001_349_343_22,
-            -0.003_673_428_44,
-            0.005_739_507_73,
-            -0.007_622_461_3,
-            0.009_438_870_47,
-            1.001_674_06,
-            2.832_976_82,
-        ] {
-            p = c + p * w;
-        }
-        p
-    };
+    let w = -ln((1.0 - y) * (1.0 + y));
+    let centre = [
+        3.432_739_39e-07,
+        -3.523_387_7e-06,
+        -4.391_506_54e-06,
+        0.000_218_580_87,
+        -0.001_253_725_03,
+        -0.004_177_681_64,
+        0.246_640_727,
+        1.501_409_41,
+    ];
+    let tail = [
+        0.000_100_950_558,
+        0.001_349_343_22,
+        -0.003_673_428_44,
+        0.005_739_507_73,
+        -0.007_622_461_3,
+        0.009_438_870_47,
+        1.001_674_06,
+        2.832_976_82,
+    ];
+    let horner = |p0: f64, c: [f64; 8], w: f64| c.into_iter().fold(p0, |p, c| c + p * w);
+    let p_centre = horner(2.810_226_36e-08, centre, w - 2.5);
+    let p_tail = horner(-0.000_200_214_257, tail, w.sqrt() - 3.0);
+    let p = if w < 5.0 { p_centre } else { p_tail };
     p * y
 }
 

@@ -10,10 +10,13 @@
 //! Both samplers work in slope space: m = normalize(-x, -y, 1) and D(m) cos(theta_m) dω equals
 //! the slope density P22(x, y) dx dy; stretching slopes by (alpha_u, alpha_v) gives anisotropy.
 
+use super::elementary::{atan, exp, ln};
 use super::erf::{erfc_from_exp, erfinv, erfinv_approx};
 pub use crate::scene::desc::MicrofacetDistribution;
 use glam::{DVec3, Vec2, Vec3};
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_2_SQRT_PI, PI};
+
+const SQRT_PI: f64 = 1.772_453_850_905_516;
 
 /// Below this roughness f32 evaluation of D loses its peak (Mitsuba clamps at the same value).
 pub const MIN_ALPHA: f32 = 1e-4;
@@ -35,62 +38,73 @@ impl Microfacet {
     }
 
     /// Normal distribution D(m), zero for normals facing down.
-    #[inline]
+    #[inline(always)]
     pub fn d(&self, m: Vec3) -> f32 {
-        if m.z <= 0.0 {
-            return 0.0;
-        }
+        let up = m.z > 0.0;
         let m = m.as_dvec3();
         let (au, av) = (self.alpha_u as f64, self.alpha_v as f64);
         let (x, y) = (m.x / au, m.y / av);
         let z2 = m.z * m.z;
         let d = match self.distribution {
             MicrofacetDistribution::Beckmann => {
-                (-(x * x + y * y) / z2).exp() / (PI * au * av * z2 * z2)
+                exp(-(x * x + y * y) / z2) / (PI * au * av * z2 * z2)
             }
             MicrofacetDistribution::Ggx => {
                 let t = x * x + y * y + z2;
                 1.0 / (PI * au * av * t * t)
             }
         };
-        d as f32
+        // A select, not an early return: `integrator::lanes` runs this in vector lanes.
+        if up {
+            d as f32
+        } else {
+            0.0
+        }
     }
 
     /// Smith's Lambda for direction w (independent of the microfacet normal).
-    #[inline]
+    #[inline(always)]
     pub fn lambda(&self, w: Vec3) -> f32 {
         let w = w.as_dvec3();
         let (au, av) = (self.alpha_u as f64, self.alpha_v as f64);
         // alpha(w)^2 tan^2(theta_w), the squared slope scale seen from w.
         let a2t2 = ((w.x * au).powi(2) + (w.y * av).powi(2)) / (w.z * w.z);
-        if !a2t2.is_finite() {
-            return f32::INFINITY;
-        }
         let l = match self.distribution {
             MicrofacetDistribution::Ggx => 0.5 * ((1.0 + a2t2).sqrt() - 1.0),
             MicrofacetDistribution::Beckmann => {
-                if a2t2 <= 0.0 {
-                    return 0.0;
-                }
+                // Evaluated for every a2t2 and then selected (see `d`).
                 let a = 1.0 / a2t2.sqrt();
-                if a > 6.0 {
+                let e = exp(-a * a);
+                let l = 0.5 * (e / (a * SQRT_PI) - erfc_from_exp(a, e));
+                if a2t2 <= 0.0 || a > 6.0 {
                     0.0
                 } else {
-                    let e = (-a * a).exp();
-                    0.5 * (e / (a * PI.sqrt()) - erfc_from_exp(a, e))
+                    l
                 }
             }
         };
-        l.max(0.0) as f32
+        if a2t2.is_finite() {
+            l.max(0.0) as f32
+        } else {
+            f32::INFINITY
+        }
     }
 
     /// Masking of normal m seen from w; zero when w sees the back of m or of the surface.
-    #[inline]
+    #[inline(always)]
     pub fn g1(&self, w: Vec3, m: Vec3) -> f32 {
+        self.g1_given(w, m, self.lambda(w))
+    }
+
+    /// `g1` given Lambda(w).
+    #[inline(always)]
+    pub fn g1_given(&self, w: Vec3, m: Vec3, lambda: f32) -> f32 {
+        let g = 1.0 / (1.0 + lambda);
         if w.dot(m) * w.z <= 0.0 {
-            return 0.0;
+            0.0
+        } else {
+            g
         }
-        1.0 / (1.0 + self.lambda(w))
     }
 
     /// A normal with density D(m) cos(theta_m).
@@ -156,24 +170,67 @@ impl Microfacet {
     /// projected incident direction from its visible marginal, y from a Gaussian, rotate back
     /// and unstretch.
     fn sample_visible_beckmann(&self, wi: Vec3, u: Vec2) -> Vec3 {
+        let mut b = self.beckmann_visible_begin(wi, u);
+        for _ in 0..SlopeInversion::FIXED_STEPS {
+            b.slope.step();
+        }
+        b.slope.finish();
+        self.beckmann_visible_end(&b)
+    }
+
+    /// `sample_visible_beckmann` up to the slope inversion's Newton steps. Its three parts
+    /// are separate functions for the lane kernel, which runs each in a loop of its own.
+    #[inline(always)]
+    pub(crate) fn beckmann_visible_begin(&self, wi: Vec3, u: Vec2) -> BeckmannVisible {
+        let (cos_phi, sin_phi, tan_t) = self.beckmann_visible_azimuth(wi);
+        BeckmannVisible {
+            cos_phi,
+            sin_phi,
+            y: beckmann_visible_y(u.y),
+            slope: SlopeInversion::new(tan_t, u.x as f64),
+        }
+    }
+
+    /// wi's azimuth (cos, sin) and tan(theta) in the stretched configuration.
+    #[inline(always)]
+    pub(crate) fn beckmann_visible_azimuth(&self, wi: Vec3) -> (f64, f64, f64) {
         let (au, av) = (self.alpha_u as f64, self.alpha_v as f64);
         let wi = wi.as_dvec3();
         let ws = DVec3::new(au * wi.x, av * wi.y, wi.z).normalize();
         let sin_t = (ws.x * ws.x + ws.y * ws.y).sqrt();
         let tan_t = sin_t / ws.z;
-        let (cp, sp) = if sin_t > 0.0 {
-            (ws.x / sin_t, ws.y / sin_t)
-        } else {
-            (1.0, 0.0)
-        };
-        // The y marginal is Gaussian (variance 1/2): a plain inverse erf. Computed first, its
-        // dependency chain overlaps the slope inversion's instead of following it.
-        let y = erfinv(2.0 * (u.y as f64).clamp(1e-12, 1.0 - 1e-12) - 1.0);
-        let x = beckmann_visible_slope(tan_t, u.x as f64);
-        let sx = (cp * x - sp * y) * au;
-        let sy = (sp * x + cp * y) * av;
+        let has_azimuth = sin_t > 0.0;
+        let cos_phi = if has_azimuth { ws.x / sin_t } else { 1.0 };
+        let sin_phi = if has_azimuth { ws.y / sin_t } else { 0.0 };
+        (cos_phi, sin_phi, tan_t)
+    }
+
+    /// `sample_visible_beckmann` after the slope inversion: rotate back and unstretch.
+    #[inline(always)]
+    pub(crate) fn beckmann_visible_end(&self, b: &BeckmannVisible) -> Vec3 {
+        let (au, av) = (self.alpha_u as f64, self.alpha_v as f64);
+        let (x, y) = (b.slope.x, b.y);
+        let sx = (b.cos_phi * x - b.sin_phi * y) * au;
+        let sy = (b.sin_phi * x + b.cos_phi * y) * av;
         DVec3::new(-sx, -sy, 1.0).normalize().as_vec3()
     }
+}
+
+/// The visible slope y, whose marginal is Gaussian (variance 1/2): a plain inverse erf.
+#[inline(always)]
+pub(crate) fn beckmann_visible_y(u: f32) -> f64 {
+    erfinv(2.0 * (u as f64).clamp(1e-12, 1.0 - 1e-12) - 1.0)
+}
+
+/// A Beckmann visible-normal sample between `beckmann_visible_begin` and `_end`: the
+/// incident azimuth in the stretched configuration, the Gaussian slope y and the inversion
+/// of the slope x.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct BeckmannVisible {
+    pub cos_phi: f64,
+    pub sin_phi: f64,
+    pub y: f64,
+    pub slope: SlopeInversion,
 }
 
 // Newton iterations of the slope inversion, counted for the cost test.
@@ -184,48 +241,123 @@ thread_local!(pub static ITERS: std::cell::Cell<u64> = const { std::cell::Cell::
 /// seen at tan(theta) = `tan_t` along +x. The density is proportional to
 /// exp(-x^2) (cot(theta) - x) on x < cot(theta); its CDF, times 2 / (sqrt(pi) cot(theta)), is
 ///   C(x) = erfc(-x) + tan(theta) / sqrt(pi) exp(-x^2).
-/// Safeguarded Newton (bisection fallback). It stops when a Newton step is below 1e-6: Newton
-/// converges quadratically there, so the returned point is ~1e-12 from the root, far finer than
-/// the f32 normal it feeds (stopping at steps below 1e-9 cost one more erfc and exp per sample
-/// for no visible digit).
-fn beckmann_visible_slope(tan_t: f64, u: f64) -> f64 {
-    let k = tan_t / PI.sqrt();
-    // C(x) from exp(-x^2), which erfc and the Newton step's derivative share.
-    let cdf = |x: f64, e: f64| erfc_from_exp(-x, e) + k * e;
-    // Beyond |x| = 9 both terms are below 1e-35 of the total: nothing left to sample.
-    let (mut lo, mut hi) = (-9.0f64, if tan_t > 1.0 / 9.0 { 1.0 / tan_t } else { 9.0 });
-    // hi > 0, so erfc(-hi) is exactly 2 - erfc(hi) (that is how `erfc` makes it).
-    let e_hi = (-hi * hi).exp();
-    let erfc_hi = erfc_from_exp(hi, e_hi);
-    let target = u.clamp(1e-12, 1.0 - 1e-12) * ((2.0 - erfc_hi) + k * e_hi);
-    // Mitsuba 3's starting guess, in erf space: a power of 1 - u fitted in theta.
-    let c = 1.0 - erfc_hi;
-    let theta = tan_t.atan();
-    let fit = 1.0 + theta * (-0.876 + theta * (0.4265 - 0.0594 * theta));
-    let guess = c - (1.0 + c) * (1.0 - u).max(0.0).powf(fit);
-    let mut x = erfinv_approx(guess).clamp(lo, hi);
-    for _it in 0..64 {
+/// Safeguarded Newton (bisection fallback) from Mitsuba 3's starting guess. Every inversion
+/// takes `FIXED_STEPS` steps, then more only until a Newton step is below 1e-6 (Newton
+/// converges quadratically there, so the point is ~1e-12 from the root, far finer than the
+/// f32 normal it feeds). The fixed steps have no branches: `integrator::lanes` runs them for
+/// eight samples in vector lanes, and the scalar path runs the same steps.
+#[derive(Clone, Copy, Default)]
+pub(crate) struct SlopeInversion {
+    /// The current point, inside the bracket (lo, hi) around the root.
+    pub x: f64,
+    pub lo: f64,
+    pub hi: f64,
+    pub target: f64,
+    pub tan_t: f64,
+    pub k: f64,
+    /// Whether the last step converged.
+    pub done: bool,
+}
+
+impl SlopeInversion {
+    /// Steps every inversion takes. With the starting guess, 39 % of the Veach scene's
+    /// plate samples converged in 2 steps, 57 % in 3 and 4 % in 4.
+    pub const FIXED_STEPS: usize = 3;
+
+    #[inline(always)]
+    pub fn new(tan_t: f64, u: f64) -> Self {
+        let k = tan_t / SQRT_PI;
+        // Beyond |x| = 9 both terms are below 1e-35 of the total: nothing left to sample.
+        let cot_t = 1.0 / tan_t;
+        let hi = if tan_t > 1.0 / 9.0 { cot_t } else { 9.0 };
+        let lo = -9.0;
+        // hi > 0, so erfc(-hi) is exactly 2 - erfc(hi) (that is how `erfc` makes it).
+        let e_hi = exp(-hi * hi);
+        let erfc_hi = erfc_from_exp(hi, e_hi);
+        let target = u.clamp(1e-12, 1.0 - 1e-12) * ((2.0 - erfc_hi) + k * e_hi);
+        // Mitsuba 3's starting guess, in erf space: a power of 1 - u fitted in theta.
+        let c = 1.0 - erfc_hi;
+        let theta = atan(tan_t);
+        let fit = 1.0 + theta * (-0.876 + theta * (0.4265 - 0.0594 * theta));
+        let guess = c - (1.0 + c) * exp(fit * ln((1.0 - u).max(0.0)));
+        // `clamp` by hand: `f64::clamp` asserts lo <= hi, a panic path that kept this loop
+        // out of vector lanes in the lane kernel.
+        let g = erfinv_approx(guess);
+        let x = if g < lo {
+            lo
+        } else if g > hi {
+            hi
+        } else {
+            g
+        };
+        SlopeInversion {
+            x,
+            lo,
+            hi,
+            target,
+            tan_t,
+            k,
+            done: false,
+        }
+    }
+
+    /// One safeguarded Newton step on C(x) - target.
+    #[inline(always)]
+    pub fn step(&mut self) {
         #[cfg(test)]
         ITERS.with(|c| c.set(c.get() + 1));
-        let e = (-x * x).exp();
-        let f = cdf(x, e) - target;
-        if f > 0.0 {
-            hi = x;
-        } else {
-            lo = x;
-        }
-        let df = 2.0 / PI.sqrt() * e * (1.0 - x * tan_t);
-        let mut next = x - f / df;
-        if !(next > lo && next < hi) {
-            next = 0.5 * (lo + hi);
-        }
-        let newton = next == x - f / df;
-        if (newton && (next - x).abs() < 1e-6 * (1.0 + x.abs())) || hi - lo < 1e-12 {
-            return next;
-        }
-        x = next;
+        let (x, lo, hi, done) =
+            slope_step(self.x, self.lo, self.hi, self.target, self.tan_t, self.k);
+        (self.x, self.lo, self.hi, self.done) = (x, lo, hi, done);
     }
-    x
+
+    /// Steps after the fixed ones, while the last did not converge (at most 64 in all).
+    #[inline]
+    pub fn finish(&mut self) {
+        for _ in Self::FIXED_STEPS..64 {
+            if self.done {
+                return;
+            }
+            self.step();
+        }
+    }
+}
+
+/// `SlopeInversion::step` on its fields, for the lane kernel's structure-of-arrays copy of
+/// eight inversions: returns the new point, bracket and whether the step converged.
+#[inline(always)]
+pub(crate) fn slope_step(
+    x: f64,
+    lo: f64,
+    hi: f64,
+    target: f64,
+    tan_t: f64,
+    k: f64,
+) -> (f64, f64, f64, bool) {
+    let e = exp(-x * x);
+    let f = erfc_from_exp(-x, e) + k * e - target;
+    // f = 0 leaves the bracket as it is: x is then a root, and the Newton step to x itself
+    // must stay inside.
+    let hi = if f > 0.0 { x } else { hi };
+    let lo = if f < 0.0 { x } else { lo };
+    let newton = x - f / (FRAC_2_SQRT_PI * e * (1.0 - x * tan_t));
+    // Inclusive: at the root, a step below an ulp of x lands on x, which the bracket's
+    // update may just have made an end.
+    let inside = newton >= lo && newton <= hi;
+    let next = if inside { newton } else { 0.5 * (lo + hi) };
+    let done = (inside && (next - x).abs() < 1e-6 * (1.0 + x.abs())) || hi - lo < 1e-12;
+    (next, lo, hi, done)
+}
+
+/// `SlopeInversion` from start to root.
+#[cfg(test)]
+fn beckmann_visible_slope(tan_t: f64, u: f64) -> f64 {
+    let mut s = SlopeInversion::new(tan_t, u);
+    for _ in 0..SlopeInversion::FIXED_STEPS {
+        s.step();
+    }
+    s.finish();
+    s.x
 }
 
 #[cfg(test)]

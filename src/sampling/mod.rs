@@ -1,6 +1,7 @@
 //! Sampling routines: warps of the unit square and discrete distributions.
 
 pub mod discrete;
+pub(crate) mod elementary;
 pub(crate) mod erf;
 pub mod microfacet;
 #[cfg(test)]

@@ -1,0 +1,209 @@
+//! The lane kernel's shading of rough conductors: Beckmann, visible-normal sampling, a grey
+//! index (`lanes::rough_covered`), the plates of the Veach scene.
+//!
+//! Each pass is a loop over the eight lanes that calls the scalar code of `li`'s path in the
+//! same order: `RoughConductor::eval_pdf_with` for the light sample; then the visible-normal
+//! sampler in its parts (`beckmann_visible_begin`, the slope inversion's fixed Newton steps,
+//! the steps some lanes still need, `beckmann_visible_end`) and `RoughConductor::reflect`.
+//! The parts without branches run in vector lanes; the samples stay bitwise `li`'s.
+
+#![allow(clippy::needless_range_loop)]
+
+use super::direct::{heuristic, Direct};
+use super::lanes::{light_sample, CameraHits, LightDraws, Shaded, SphereDraws, V3x8};
+use crate::bsdf::fresnel::fresnel_conductor_channel;
+use crate::bsdf::RoughConductor;
+use crate::math::{offset_origin, Frame, Rgb};
+use crate::rng::LANES;
+use crate::sampling::microfacet::{
+    beckmann_visible_y, slope_step, BeckmannVisible, Microfacet, MicrofacetDistribution,
+    SlopeInversion,
+};
+use glam::Vec3;
+
+impl CameraHits {
+    /// Lane i's rough conductor, rebuilt from the lane arrays.
+    #[inline(always)]
+    fn rough_conductor(&self, i: usize) -> RoughConductor {
+        RoughConductor {
+            mf: Microfacet {
+                distribution: MicrofacetDistribution::Beckmann,
+                alpha_u: self.alpha_u[i],
+                alpha_v: self.alpha_v[i],
+            },
+            sample_visible: true,
+            eta: Rgb::splat(self.eta[i]),
+            k: Rgb::splat(self.k[i]),
+            specular_reflectance: self.reflectance.get(i),
+        }
+    }
+
+    /// Lane i's Fresnel term times specular reflectance: `RoughConductor::fresnel` for a
+    /// grey index, without its test for one.
+    #[inline(always)]
+    fn fresnel(&self, i: usize) -> impl Fn(f32) -> Rgb {
+        let (eta, k, spec) = (self.eta[i], self.k[i], self.reflectance.get(i));
+        move |c| Rgb::splat(fresnel_conductor_channel(c, eta, k)) * spec
+    }
+}
+
+impl Direct<'_> {
+    /// `shade_and_trace` for a batch of rough-conductor hits, out of line (see
+    /// `shade_and_trace_spheres`).
+    #[inline(never)]
+    pub(super) fn shade_and_trace_rough(
+        &self,
+        h: &CameraHits,
+        ld: &LightDraws,
+        sd: &SphereDraws,
+        u: &[[f32; LANES]; 7],
+        out: &mut [Rgb; LANES],
+    ) {
+        let shaded = self.shade_rough(h, ld, sd, u);
+        self.trace_and_sum(h, &shaded, out);
+    }
+
+    #[inline(always)]
+    fn shade_rough(
+        &self,
+        h: &CameraHits,
+        ld: &LightDraws,
+        sd: &SphereDraws,
+        u: &[[f32; LANES]; 7],
+    ) -> Shaded {
+        let s = &self.strategy;
+        let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
+        let mut o = Shaded::default();
+        // The light samples, apart: a sphere light's point takes a libm sin/cos, a call that
+        // would keep the loops below from running in vector lanes.
+        let (mut drawn, mut wl, mut pdf_area, mut radiance) = (
+            [false; LANES],
+            V3x8::default(),
+            [0.0f32; LANES],
+            V3x8::default(),
+        );
+        for i in 0..LANES {
+            let (p, ng, err) = (h.p.get(i), h.ng.get(i), h.err.get(i));
+            let (ok, w, pdf, li, lsp) = light_sample::<true>(p, ld, sd, u, i);
+            (drawn[i], pdf_area[i]) = (ok, pdf);
+            wl.set(i, w);
+            radiance.set(i, li);
+            let lp = lsp.p;
+            let so = offset_origin(p, ng, err, lp - p);
+            o.shadow_o.set(i, so);
+            o.shadow_target
+                .set(i, offset_origin(lp, lsp.ng, lsp.err_scale, so - lp));
+        }
+        let mut wi_local = V3x8::default();
+        let mut lambda_i = [0.0f32; LANES];
+        for i in 0..LANES {
+            let frame = Frame::from_normal(h.ns.get(i));
+            let wi = frame.to_local(-h.d.get(i));
+            let rc = h.rough_conductor(i);
+            // Smith's Lambda(wi), once for both samples' evaluations.
+            let lambda = rc.mf.lambda(wi);
+            // `light_finish` before its visibility test; `RoughConductor::eval_pdf`'s early
+            // return below the horizon is `eval_pdf_with`'s select.
+            let wo = frame.to_local(wl.get(i));
+            let (f, pdf_bsdf) = rc.eval_pdf_with(wi, wo, lambda, h.fresnel(i));
+            let p_light = ld.pmf[i] * pdf_area[i];
+            let w = heuristic(s.heuristic, ne * p_light, nb * pdf_bsdf);
+            let radiance = radiance.get(i);
+            o.light.set(i, f * radiance * (w / p_light));
+            o.light_ok[i] = drawn[i] && f != Rgb::ZERO && radiance != Rgb::ZERO;
+            wi_local.set(i, wi);
+            lambda_i[i] = lambda;
+        }
+        let mut vis = VisibleX8::default();
+        for i in 0..LANES {
+            vis.y[i] = beckmann_visible_y(u[6][i]);
+        }
+        for i in 0..LANES {
+            let rc = h.rough_conductor(i);
+            let (cos_phi, sin_phi, tan_t) = rc.mf.beckmann_visible_azimuth(wi_local.get(i));
+            (vis.cos_phi[i], vis.sin_phi[i], vis.tan_t[i]) = (cos_phi, sin_phi, tan_t);
+        }
+        for i in 0..LANES {
+            let b = SlopeInversion::new(vis.tan_t[i], u[5][i] as f64);
+            (vis.x[i], vis.lo[i], vis.hi[i], vis.done[i]) = (b.x, b.lo, b.hi, b.done);
+            (vis.target[i], vis.k[i]) = (b.target, b.k);
+        }
+        for _ in 0..SlopeInversion::FIXED_STEPS {
+            for i in 0..LANES {
+                let v = &mut vis;
+                (v.x[i], v.lo[i], v.hi[i], v.done[i]) =
+                    slope_step(v.x[i], v.lo[i], v.hi[i], v.target[i], v.tan_t[i], v.k[i]);
+            }
+        }
+        for i in 0..LANES {
+            if !vis.done[i] {
+                let mut b = vis.get(i);
+                b.slope.finish();
+                vis.set(i, b);
+            }
+        }
+        for i in 0..LANES {
+            let (p, ng, err) = (h.p.get(i), h.ng.get(i), h.err.get(i));
+            let rc = h.rough_conductor(i);
+            let wi = wi_local.get(i);
+            let m = rc.mf.beckmann_visible_end(&vis.get(i));
+            // `RoughConductor::sample`, whose first test is wi.z > 0.
+            let bs = rc.reflect(wi, m, lambda_i[i], h.fresnel(i));
+            let (ok, wo, pdf, weight) = match bs {
+                Some(bs) => (wi.z > 0.0, bs.wo, bs.pdf, bs.weight),
+                None => (false, Vec3::Z, 0.0, Rgb::ZERO),
+            };
+            o.bsdf_ok[i] = ok;
+            o.bsdf_pdf[i] = pdf;
+            o.bsdf_weight.set(i, weight);
+            let d = Frame::from_normal(h.ns.get(i)).to_world(wo);
+            o.bsdf_d.set(i, d);
+            o.bsdf_o.set(i, offset_origin(p, ng, err, d));
+        }
+        o
+    }
+}
+
+/// Eight `BeckmannVisible`s, one array per field: the loops over them then run in vector
+/// lanes, which they did not over an array of the structures.
+#[derive(Default)]
+struct VisibleX8 {
+    cos_phi: [f64; LANES],
+    sin_phi: [f64; LANES],
+    y: [f64; LANES],
+    x: [f64; LANES],
+    lo: [f64; LANES],
+    hi: [f64; LANES],
+    target: [f64; LANES],
+    tan_t: [f64; LANES],
+    k: [f64; LANES],
+    done: [bool; LANES],
+}
+
+impl VisibleX8 {
+    #[inline(always)]
+    fn set(&mut self, i: usize, b: BeckmannVisible) {
+        (self.cos_phi[i], self.sin_phi[i], self.y[i]) = (b.cos_phi, b.sin_phi, b.y);
+        let s = b.slope;
+        (self.x[i], self.lo[i], self.hi[i], self.done[i]) = (s.x, s.lo, s.hi, s.done);
+        (self.target[i], self.tan_t[i], self.k[i]) = (s.target, s.tan_t, s.k);
+    }
+
+    #[inline(always)]
+    fn get(&self, i: usize) -> BeckmannVisible {
+        BeckmannVisible {
+            cos_phi: self.cos_phi[i],
+            sin_phi: self.sin_phi[i],
+            y: self.y[i],
+            slope: SlopeInversion {
+                x: self.x[i],
+                lo: self.lo[i],
+                hi: self.hi[i],
+                target: self.target[i],
+                tan_t: self.tan_t[i],
+                k: self.k[i],
+                done: self.done[i],
+            },
+        }
+    }
+}
