@@ -7,9 +7,10 @@
 //! sample is bitwise what `li` gives it (`render` tests this on the bundled scenes).
 //!
 //! It covers the configuration of the study's figures: MIS with one light and one BSDF sample,
-//! area sampling, every emitter an area light on a mesh or a sphere. A camera hit whose
-//! material is not one-sided diffuse goes to `li_hit`, the scalar definition; other
-//! configurations go to `li`.
+//! area sampling, every emitter an area light on a mesh or a sphere. Camera hits on one-sided
+//! diffuse surfaces shade here; batches of one-sided Beckmann rough conductors shade in
+//! `lanes_rough`. Other hits go to `li_hit`, the scalar definition; other configurations go
+//! to `li`.
 
 // Lane loops index a dozen structure-of-arrays fields by the same lane number; iterators
 // over one of them would hide that symmetry.
