@@ -74,8 +74,8 @@ impl Direct<'_> {
         let s = &self.strategy;
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
         let mut o = Shaded::default();
-        // The light samples, apart: a sphere light's point takes a libm sin/cos, a call that
-        // would keep the loops below from running in vector lanes.
+        // The light samples in a loop of their own. Merged with the evaluation below, when a
+        // sphere light's point still called libm's sin/cos, the whole loop ran scalar.
         let (mut drawn, mut wl, mut pdf_area, mut radiance) = (
             [false; LANES],
             V3x8::default(),
