@@ -74,29 +74,16 @@ impl Direct<'_> {
         let s = &self.strategy;
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
         let mut o = Shaded::default();
-        // The light samples in a loop of their own. Merged with the evaluation below, when a
-        // sphere light's point still called libm's sin/cos, the whole loop ran scalar.
-        let (mut drawn, mut wl, mut pdf_area, mut radiance) = (
-            [false; LANES],
-            V3x8::default(),
-            [0.0f32; LANES],
-            V3x8::default(),
-        );
+        let mut wi_local = V3x8::default();
+        let mut lambda_i = [0.0f32; LANES];
         for i in 0..LANES {
             let (p, ng, err) = (h.p.get(i), h.ng.get(i), h.err.get(i));
-            let (ok, w, pdf, li, lsp) = light_sample::<true>(p, ld, sd, u, i);
-            (drawn[i], pdf_area[i]) = (ok, pdf);
-            wl.set(i, w);
-            radiance.set(i, li);
+            let (drawn, wl, pdf_area, radiance, lsp) = light_sample::<true>(p, ld, sd, u, i);
             let lp = lsp.p;
             let so = offset_origin(p, ng, err, lp - p);
             o.shadow_o.set(i, so);
             o.shadow_target
                 .set(i, offset_origin(lp, lsp.ng, lsp.err_scale, so - lp));
-        }
-        let mut wi_local = V3x8::default();
-        let mut lambda_i = [0.0f32; LANES];
-        for i in 0..LANES {
             let frame = Frame::from_normal(h.ns.get(i));
             let wi = frame.to_local(-h.d.get(i));
             let rc = h.rough_conductor(i);
@@ -104,13 +91,12 @@ impl Direct<'_> {
             let lambda = rc.mf.lambda(wi);
             // `light_finish` before its visibility test; `RoughConductor::eval_pdf`'s early
             // return below the horizon is `eval_pdf_with`'s select.
-            let wo = frame.to_local(wl.get(i));
+            let wo = frame.to_local(wl);
             let (f, pdf_bsdf) = rc.eval_pdf_with(wi, wo, lambda, h.fresnel(i));
-            let p_light = ld.pmf[i] * pdf_area[i];
+            let p_light = ld.pmf[i] * pdf_area;
             let w = heuristic(s.heuristic, ne * p_light, nb * pdf_bsdf);
-            let radiance = radiance.get(i);
             o.light.set(i, f * radiance * (w / p_light));
-            o.light_ok[i] = drawn[i] && f != Rgb::ZERO && radiance != Rgb::ZERO;
+            o.light_ok[i] = drawn && f != Rgb::ZERO && radiance != Rgb::ZERO;
             wi_local.set(i, wi);
             lambda_i[i] = lambda;
         }
