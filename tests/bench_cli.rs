@@ -45,6 +45,7 @@ fn bench_writes_every_section() {
         "of render time outside traversal",
         "raw obvhs",
         "growth over",
+        "machine: ",
     ] {
         assert!(
             stdout.contains(printed),
@@ -59,6 +60,9 @@ fn bench_writes_every_section() {
         let row = row.unwrap();
         let value: f64 = row[5].parse().unwrap();
         let what = format!("{} {} {}", &row[0], &row[2], &row[4]);
+        if &row[0] == "machine" {
+            assert!(!row[2].is_empty(), "machine row names no CPU");
+        }
         // The share outside traversal is a difference of two timings: at toy sizes it may be
         // anything, but it is a number.
         if row[2].contains("share_outside_traversal") {
@@ -102,5 +106,7 @@ fn bench_writes_every_section() {
     assert_eq!(sections["scaling_emitters"], 4, "{sections:?}");
     assert_eq!(sections["emitter_choice"], 4, "{sections:?}");
     assert_eq!(sections["peak_memory"], 1, "{sections:?}");
+    // The CPU the numbers were measured on, named.
+    assert_eq!(sections["machine"], 1, "{sections:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }

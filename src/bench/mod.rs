@@ -207,6 +207,17 @@ fn choice_run_ns(selector: &crate::emitter::EmitterSelector) -> f64 {
 }
 
 /// Peak resident memory of this process in bytes (Linux), if known.
+/// The CPU's model name, from /proc/cpuinfo where there is one.
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|info| {
+            let line = info.lines().find(|l| l.starts_with("model name"))?;
+            Some(line.split_once(':')?.1.trim().to_string())
+        })
+        .unwrap_or_else(|| format!("unknown {} CPU", std::env::consts::ARCH))
+}
+
 fn peak_memory() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
@@ -224,6 +235,20 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         a.scenes.clone()
     };
     let mut rows = Vec::new();
+    // Every number below is this machine's: the same code has read 35 % apart on two VMs of
+    // the same size, and the share outside traversal moves with the CPU too.
+    let cpus = std::thread::available_parallelism().map_or(0, |n| n.get());
+    let model = cpu_model();
+    println!("machine: {model}, {cpus} logical CPUs");
+    rows.push(Row {
+        section: "machine",
+        scene: String::new(),
+        strategy: model,
+        threads: cpus,
+        n: 0,
+        value: cpus as f64,
+        unit: "logical CPUs",
+    });
     let max_threads = a.threads.iter().copied().max().unwrap_or(1);
     println!(
         "render throughput, {}x{} at {} spp (best of {}):",
