@@ -1,0 +1,103 @@
+#!/usr/bin/env python3
+"""Mitsuba 3's speed on the bundled scenes, for comparison with `directlab bench` on the same
+machine: camera samples per second of its `direct` integrator (one light and one BSDF sample,
+power-heuristic MIS: the bench's mis-power-e1b1 rows), render time only.
+
+    pip install mitsuba            # 3.9.1 here; llvm_ad_rgb also needs: apt-get install libllvm19
+    python3 experiments/mitsuba3_speed.py [--threads 2] [--spp 64] [--repeat 5]
+
+Prints one line per variant and scene and writes reports/bench/mitsuba3.csv (same columns as
+bench.csv). Each number is the best of --repeat renders; the JIT variant's first, compiling
+render is timed apart and not counted. Mitsuba needs 2 or more threads (with 1, writing an EXR
+hangs), so there is no 1-thread row.
+"""
+
+import argparse
+import csv
+import os
+import platform
+import sys
+import tempfile
+import time
+
+SCENES = ["scenes/cbox/cbox.xml", "scenes/veach-mis/veach-mis.xml"]
+
+
+def cpu_model():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--res", type=int, default=256)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--variants", default="scalar_rgb,llvm_ad_rgb")
+    ap.add_argument("--out", default="reports/bench/mitsuba3.csv")
+    a = ap.parse_args()
+    if a.threads < 2:
+        sys.exit("mitsuba3_speed.py: --threads must be 2 or more (Mitsuba hangs with 1)")
+    import drjit as dr
+    import mitsuba as mi
+
+    rows = [("machine", "", cpu_model(), os.cpu_count(), 0, os.cpu_count(), "logical CPUs")]
+    print(f"machine: {cpu_model()}; Mitsuba {mi.__version__}, {a.threads} threads")
+    for variant in a.variants.split(","):
+        try:
+            mi.set_variant(variant)
+        except Exception as e:  # a variant this build or machine lacks
+            print(f"  {variant}: not available ({e})")
+            continue
+        dr.set_thread_count(a.threads)
+        for path in SCENES:
+            # Only the parameters the scene declares (the Veach scene has its own 768 x 512),
+            # as `directlab bench` does.
+            with open(path) as f:
+                declared = f.read()
+            params = {"spp": a.spp}
+            if '<default name="res"' in declared:
+                params["res"] = a.res
+            scene = mi.load_file(path, **params)
+            film = scene.sensors()[0].film()
+            n = film.size()[0] * film.size()[1] * a.spp
+            times = []
+            for i in range(a.repeat + (1 if variant.startswith("llvm") else 0)):
+                t = time.perf_counter()
+                img = mi.render(scene, spp=a.spp)
+                dr.eval(img)
+                dr.sync_thread()
+                times.append(time.perf_counter() - t)
+            first = ""
+            if variant.startswith("llvm"):
+                first = f" (first, compiling render {times[0]:.2f} s, not counted)"
+                times = times[1:]
+            best = min(times)
+            sps = n / best
+            slowest = n / max(times)
+            print(
+                f"  {variant:<12} {path:<32} {sps / 1e6:7.2f} M samples/s, "
+                f"slowest {slowest / 1e6:.2f}{first}"
+            )
+            label = f"mitsuba3-{variant}-direct-e1b1"
+            rows.append(("throughput", path, label, a.threads, 0, sps, "samples/s"))
+            rows.append(("throughput_slowest", path, label, a.threads, 0, slowest, "samples/s"))
+    os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(a.out) or ".", suffix=".tmp")
+    with os.fdopen(fd, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["section", "scene", "strategy", "threads", "n", "value", "unit"])
+        w.writerows(rows)
+    os.replace(tmp, a.out)
+    print(f"wrote {a.out}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
