@@ -46,6 +46,7 @@ fn bench_writes_every_section() {
         "raw obvhs",
         "growth over",
         "machine: ",
+        "cbox.xml: 16x16",
     ] {
         assert!(
             stdout.contains(printed),
