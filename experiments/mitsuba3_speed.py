@@ -69,7 +69,7 @@ def main():
             film = scene.sensors()[0].film()
             n = film.size()[0] * film.size()[1] * a.spp
             times = []
-            for i in range(a.repeat + (1 if variant.startswith("llvm") else 0)):
+            for _ in range(a.repeat + (1 if variant.startswith("llvm") else 0)):
                 t = time.perf_counter()
                 img = mi.render(scene, spp=a.spp)
                 dr.eval(img)

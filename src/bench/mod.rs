@@ -207,7 +207,6 @@ fn choice_run_ns(selector: &crate::emitter::EmitterSelector) -> f64 {
     start.elapsed().as_secs_f64() * 1e9 / n as f64
 }
 
-/// Peak resident memory of this process in bytes (Linux), if known.
 /// The CPU's model name, from /proc/cpuinfo where there is one.
 fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
@@ -219,6 +218,7 @@ fn cpu_model() -> String {
         .unwrap_or_else(|| format!("unknown {} CPU", std::env::consts::ARCH))
 }
 
+/// Peak resident memory of this process in bytes (Linux), if known.
 fn peak_memory() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
@@ -333,8 +333,8 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         let mix_spp = (a.spp / 16)
             .max(1)
             .next_multiple_of(crate::rng::LANES as u32);
-        let mix = raylimit::ray_mix(&scene, mix_spp);
         let mis = bench_strategies()[0];
+        let mix = raylimit::ray_mix(&scene, mix_spp, mis.selection);
         let limit = raylimit::measure(&scene, &mix, a.repeat, || {
             throughput(&scene, mis, a.spp, 1, 1)
         });
