@@ -14,31 +14,31 @@ const LEAF_SIZE: usize = 4;
 
 /// One BVH leaf: its triangles as a packet and its spheres.
 #[derive(Clone, Copy, Debug)]
-struct Leaf {
-    tris: Tri4,
+pub(super) struct Leaf {
+    pub(super) tris: Tri4,
     /// Per lane, the triangle's index in `refs` (unused lanes repeat lane 0).
-    tri_ref: [u32; 4],
-    n_tris: u32,
+    pub(super) tri_ref: [u32; 4],
+    pub(super) n_tris: u32,
     /// Range in `spheres`.
-    spheres: (u32, u32),
+    pub(super) spheres: (u32, u32),
 }
 
 impl Leaf {
     /// The lanes holding triangle `id`.
     #[inline(always)]
-    fn skip(&self, id: u32) -> BVec4A {
+    pub(super) fn skip(&self, id: u32) -> BVec4A {
         let r = &self.tri_ref;
         BVec4A::new(r[0] == id, r[1] == id, r[2] == id, r[3] == id)
     }
 }
 
 pub struct Accel {
-    bvh: WideBvh,
-    leaves: Vec<Leaf>,
+    pub(super) bvh: WideBvh,
+    pub(super) leaves: Vec<Leaf>,
     /// (centre, radius, index in `refs`).
-    spheres: Vec<(Vec3, f32, u32)>,
+    pub(super) spheres: Vec<(Vec3, f32, u32)>,
     /// (shape index, triangle index within the shape) per primitive id.
-    refs: Vec<(u32, u32)>,
+    pub(super) refs: Vec<(u32, u32)>,
     /// Per shape, the id of its first triangle (ids of a mesh's triangles are consecutive,
     /// so a surface point names its triangle's id), or `NO_SKIP` for a sphere.
     tri_base: Vec<u32>,
@@ -216,6 +216,11 @@ impl Accel {
             ShapeKind::Sphere(s) => s.surface_point(ray.o + ray.d * t, shape),
         };
         Some(Hit { t, sp })
+    }
+
+    /// The box around everything in the structure.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bvh.bounds()
     }
 
     /// False only if the ray can hit nothing here (see `WideBvh::may_enter`).

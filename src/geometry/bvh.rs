@@ -8,60 +8,61 @@
 //! the slab test is made conservative with pbrt-v4's (1 + 2 gamma(3)) factor so that a ray
 //! through the shared edge of two triangles in different leaves enters both leaves.
 
-use super::lanes8::F8;
+use super::lanes8::{F8, M8};
 use glam::{Vec3, Vec3A};
 use obvhs::{aabb::Aabb, bvh2::Bvh2};
 use std::mem::MaybeUninit;
 
 /// Child slot tags: a leaf is `LEAF | leaf index`, an internal child is its node index, an
 /// empty slot is `EMPTY` (its box is inverted so it is never entered).
-const LEAF: u32 = 1 << 31;
+pub(super) const LEAF: u32 = 1 << 31;
 const EMPTY: u32 = u32::MAX;
 /// pbrt-v4's 1 + 2 gamma(3): the slab test's far distances are scaled by it.
-const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+pub(super) const ROBUST: f32 =
+    1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 /// Stack entries the traversal keeps on its own stack; deeper trees use a heap stack.
-const STACK: usize = 64;
+pub(super) const STACK: usize = 64;
 /// Children per node, tested together.
 const W: usize = 8;
 
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
-struct Node {
+pub(super) struct Node {
     /// Per plane (min x, max x, min y, max y, min z, max z), its coordinate for each child.
     b: [[f32; W]; 6],
-    child: [u32; W],
+    pub(super) child: [u32; W],
 }
 
 pub struct WideBvh {
-    nodes: Vec<Node>,
+    pub(super) nodes: Vec<Node>,
     /// The box around everything, (min, max), for `may_enter`.
     bounds: (Vec3A, Vec3A),
     /// Per leaf: its first position in the binary BVH's `primitive_indices` and its count.
     leaves: Vec<(u32, u32)>,
     /// Stack entries a traversal may need: W - 1 per level below the root, plus one.
-    stack_need: usize,
+    pub(super) stack_need: usize,
 }
 
 /// Per-ray data of the box test.
-struct BoxRay {
+pub(super) struct BoxRay {
     o: [F8; 3],
     inv: [F8; 3],
-    /// Index into `Node::b` of each axis's near and far plane (by the direction's sign).
+    /// Index into `Node::b` of each axis's near plane (by the direction's sign); the far one is
+    /// its neighbour, `near ^ 1`.
     near: [usize; 3],
-    far: [usize; 3],
     tmin: F8,
 }
 
 /// The slab test's 1 / d. 1/0 = inf would meet a zero (b - o) and give NaN; f32::MAX keeps
 /// every product ordered (0 stays 0, anything else overflows to the right infinity).
 #[inline(always)]
-fn slab_inv(d: Vec3) -> Vec3A {
+pub(super) fn slab_inv(d: Vec3) -> Vec3A {
     (Vec3A::ONE / Vec3A::from(d)).clamp(Vec3A::splat(-f32::MAX), Vec3A::splat(f32::MAX))
 }
 
 impl BoxRay {
     #[inline(always)]
-    fn new(o: Vec3, d: Vec3, tmin: f32) -> Self {
+    pub(super) fn new(o: Vec3, d: Vec3, tmin: f32) -> Self {
         let inv = slab_inv(d);
         let neg = |x: f32| x.is_sign_negative() as usize;
         let near = [neg(inv.x), 2 + neg(inv.y), 4 + neg(inv.z)];
@@ -69,7 +70,6 @@ impl BoxRay {
             o: [F8::splat(o.x), F8::splat(o.y), F8::splat(o.z)],
             inv: [F8::splat(inv.x), F8::splat(inv.y), F8::splat(inv.z)],
             near,
-            far: near.map(|i| i ^ 1),
             tmin: F8::splat(tmin),
         }
     }
@@ -77,19 +77,38 @@ impl BoxRay {
     /// Entry distances of the children and the mask of those entered before `tmax`.
     #[inline(always)]
     fn test(&self, n: &Node, tmax: f32) -> (u32, [f32; W]) {
-        let t = |i: usize, a: usize| F8::load(&n.b[i]).sub(self.o[a]).mul(self.inv[a]);
-        let tn = t(self.near[0], 0)
-            .max(t(self.near[1], 1))
-            .max(t(self.near[2], 2))
-            .max(self.tmin);
-        let tf = t(self.far[0], 0)
-            .min(t(self.far[1], 1))
-            .min(t(self.far[2], 2))
-            .min(F8::splat(tmax));
-        let mut tns = [0.0; W];
-        tn.store(&mut tns);
-        (tn.le_mask(tf.mul(F8::splat(ROBUST))), tns)
+        let (mask, tn) = self.test8(n, tmax);
+        (mask.bitmask(), tn.to_array())
     }
+
+    /// `test` with its answers in lanes.
+    #[inline(always)]
+    pub(super) fn test8(&self, n: &Node, tmax: f32) -> (M8, F8) {
+        slab_test(n, &self.o, &self.inv, self.near, self.tmin, tmax)
+    }
+}
+
+/// The node test of one ray, its origin, slab inverse and tmin given in every lane: entry
+/// distances of the children and the lanes of those entered before `tmax`.
+#[inline(always)]
+pub(super) fn slab_test(
+    n: &Node,
+    o: &[F8; 3],
+    inv: &[F8; 3],
+    near: [usize; 3],
+    tmin: F8,
+    tmax: f32,
+) -> (M8, F8) {
+    let t = |i: usize, a: usize| F8::load(&n.b[i]).sub(o[a]).mul(inv[a]);
+    let tn = t(near[0], 0)
+        .max(t(near[1], 1))
+        .max(t(near[2], 2))
+        .max(tmin);
+    let tf = t(near[0] ^ 1, 0)
+        .min(t(near[1] ^ 1, 1))
+        .min(t(near[2] ^ 1, 2))
+        .min(F8::splat(tmax));
+    (tn.le(tf.mul(F8::splat(ROBUST))), tn)
 }
 
 /// Entry `i` of a traversal stack.
@@ -98,7 +117,7 @@ impl BoxRay {
 /// Entry `i` must have been written: the traversals read only entries below their stack
 /// pointer, each written when it was pushed.
 #[inline(always)]
-unsafe fn read<T: Copy>(stack: &[MaybeUninit<T>], i: usize) -> T {
+pub(super) unsafe fn read<T: Copy>(stack: &[MaybeUninit<T>], i: usize) -> T {
     unsafe { stack[i].assume_init() }
 }
 
@@ -202,6 +221,11 @@ impl WideBvh {
             }
         }
         depth
+    }
+
+    /// The box around everything (inverted for an empty tree).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        (self.bounds.0.into(), self.bounds.1.into())
     }
 
     /// Per leaf: its first position in the binary BVH's `primitive_indices` and its count.

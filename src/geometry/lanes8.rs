@@ -1,7 +1,8 @@
-//! Eight f32 lanes for the BVH's node test: one AVX register where the build has AVX (all
-//! eight children in one instruction per step), else two SSE halves through glam. Each lane
-//! does the same IEEE operation either way, with glam's operand order for min and max, so
-//! the traversal's answers do not depend on the build.
+//! Eight f32 lanes for the BVH's node test and the eight-ray triangle test: one AVX register
+//! where the build has AVX (all eight lanes in one instruction per step), else two SSE halves
+//! through glam. Each lane does the same IEEE operation either way, with glam's operand order
+//! for min and max, so the traversal's answers do not depend on the build, and a lane of the
+//! eight-ray triangle test computes bitwise what glam's four-lane test computes for it.
 
 #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
 mod imp {
@@ -12,6 +13,27 @@ mod imp {
 
     #[derive(Clone, Copy)]
     pub struct F8(__m256);
+
+    /// Eight lane masks (all ones or all zeros per lane).
+    #[derive(Clone, Copy)]
+    pub struct M8(__m256);
+
+    macro_rules! binop {
+        ($name:ident, $intr:ident) => {
+            #[inline(always)]
+            pub fn $name(self, o: F8) -> F8 {
+                F8(unsafe { $intr(self.0, o.0) })
+            }
+        };
+    }
+    macro_rules! cmp {
+        ($name:ident, $pred:ident) => {
+            #[inline(always)]
+            pub fn $name(self, o: F8) -> M8 {
+                M8(unsafe { _mm256_cmp_ps::<$pred>(self.0, o.0) })
+            }
+        };
+    }
 
     impl F8 {
         #[inline(always)]
@@ -26,36 +48,93 @@ mod imp {
         pub fn store(self, out: &mut [f32; 8]) {
             unsafe { _mm256_storeu_ps(out.as_mut_ptr(), self.0) }
         }
+        binop!(add, _mm256_add_ps);
+        binop!(sub, _mm256_sub_ps);
+        binop!(mul, _mm256_mul_ps);
+        binop!(div, _mm256_div_ps);
+        binop!(max, _mm256_max_ps);
+        binop!(min, _mm256_min_ps);
+        /// Clears the sign bit, as glam's abs.
         #[inline(always)]
-        pub fn sub(self, o: F8) -> F8 {
-            F8(unsafe { _mm256_sub_ps(self.0, o.0) })
+        pub fn abs(self) -> F8 {
+            F8(unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0) })
         }
-        #[inline(always)]
-        pub fn mul(self, o: F8) -> F8 {
-            F8(unsafe { _mm256_mul_ps(self.0, o.0) })
-        }
-        #[inline(always)]
-        pub fn max(self, o: F8) -> F8 {
-            F8(unsafe { _mm256_max_ps(self.0, o.0) })
-        }
-        #[inline(always)]
-        pub fn min(self, o: F8) -> F8 {
-            F8(unsafe { _mm256_min_ps(self.0, o.0) })
-        }
+        // Ordered predicates, false for NaN, as SSE's cmplt/cmple/cmpgt/cmpeq; cmpneq is
+        // unordered (true for NaN), as SSE's.
+        cmp!(lt, _CMP_LT_OS);
+        cmp!(le, _CMP_LE_OS);
+        cmp!(gt, _CMP_GT_OS);
+        cmp!(eq, _CMP_EQ_OQ);
+        cmp!(ne, _CMP_NEQ_UQ);
         /// Bit i set where lane i of `self` <= lane i of `o` (false for NaN, as SSE's cmple).
         #[inline(always)]
         pub fn le_mask(self, o: F8) -> u32 {
-            unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(self.0, o.0)) as u32 }
+            self.le(o).bitmask()
+        }
+        /// `a` where the mask is set, else `b`.
+        #[inline(always)]
+        pub fn select(m: M8, a: F8, b: F8) -> F8 {
+            F8(unsafe { _mm256_blendv_ps(b.0, a.0, m.0) })
+        }
+    }
+
+    impl M8 {
+        /// Lane i set where bit i of `bits` is.
+        #[inline(always)]
+        pub fn from_bits(bits: u32) -> M8 {
+            unsafe {
+                let lanes = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+                let b = _mm256_and_si256(_mm256_set1_epi32(bits as i32), lanes);
+                M8(_mm256_castsi256_ps(_mm256_cmpeq_epi32(b, lanes)))
+            }
+        }
+        #[inline(always)]
+        pub fn bitmask(self) -> u32 {
+            unsafe { _mm256_movemask_ps(self.0) as u32 }
+        }
+        #[inline(always)]
+        pub fn and(self, o: M8) -> M8 {
+            M8(unsafe { _mm256_and_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        pub fn or(self, o: M8) -> M8 {
+            M8(unsafe { _mm256_or_ps(self.0, o.0) })
+        }
+        /// `self` and not `o`.
+        #[inline(always)]
+        pub fn and_not(self, o: M8) -> M8 {
+            M8(unsafe { _mm256_andnot_ps(o.0, self.0) })
         }
     }
 }
 
 #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
 mod imp {
-    use glam::Vec4;
+    use glam::{BVec4A, Vec4};
 
     #[derive(Clone, Copy)]
     pub struct F8([Vec4; 2]);
+
+    #[derive(Clone, Copy)]
+    pub struct M8([BVec4A; 2]);
+
+    macro_rules! binop {
+        ($name:ident, $f:expr) => {
+            #[inline(always)]
+            pub fn $name(self, o: F8) -> F8 {
+                let f = $f;
+                F8([f(self.0[0], o.0[0]), f(self.0[1], o.0[1])])
+            }
+        };
+    }
+    macro_rules! cmp {
+        ($name:ident, $f:ident) => {
+            #[inline(always)]
+            pub fn $name(self, o: F8) -> M8 {
+                M8([self.0[0].$f(o.0[0]), self.0[1].$f(o.0[1])])
+            }
+        };
+    }
 
     impl F8 {
         #[inline(always)]
@@ -71,34 +150,72 @@ mod imp {
             self.0[0].write_to_slice(&mut out[..4]);
             self.0[1].write_to_slice(&mut out[4..]);
         }
+        binop!(add, |a: Vec4, b: Vec4| a + b);
+        binop!(sub, |a: Vec4, b: Vec4| a - b);
+        binop!(mul, |a: Vec4, b: Vec4| a * b);
+        binop!(div, |a: Vec4, b: Vec4| a / b);
+        binop!(max, Vec4::max);
+        binop!(min, Vec4::min);
         #[inline(always)]
-        fn zip(self, o: F8, f: impl Fn(Vec4, Vec4) -> Vec4) -> F8 {
-            F8([f(self.0[0], o.0[0]), f(self.0[1], o.0[1])])
+        pub fn abs(self) -> F8 {
+            F8([self.0[0].abs(), self.0[1].abs()])
         }
-        #[inline(always)]
-        pub fn sub(self, o: F8) -> F8 {
-            self.zip(o, |a, b| a - b)
-        }
-        #[inline(always)]
-        pub fn mul(self, o: F8) -> F8 {
-            self.zip(o, |a, b| a * b)
-        }
-        #[inline(always)]
-        pub fn max(self, o: F8) -> F8 {
-            self.zip(o, Vec4::max)
-        }
-        #[inline(always)]
-        pub fn min(self, o: F8) -> F8 {
-            self.zip(o, Vec4::min)
-        }
+        cmp!(lt, cmplt);
+        cmp!(le, cmple);
+        cmp!(gt, cmpgt);
+        cmp!(eq, cmpeq);
+        cmp!(ne, cmpne);
         #[inline(always)]
         pub fn le_mask(self, o: F8) -> u32 {
-            self.0[0].cmple(o.0[0]).bitmask() | self.0[1].cmple(o.0[1]).bitmask() << 4
+            self.le(o).bitmask()
+        }
+        #[inline(always)]
+        pub fn select(m: M8, a: F8, b: F8) -> F8 {
+            F8([
+                Vec4::select(m.0[0], a.0[0], b.0[0]),
+                Vec4::select(m.0[1], a.0[1], b.0[1]),
+            ])
+        }
+    }
+
+    impl M8 {
+        #[inline(always)]
+        pub fn from_bits(bits: u32) -> M8 {
+            let b = |i: u32| bits >> i & 1 != 0;
+            M8([
+                BVec4A::new(b(0), b(1), b(2), b(3)),
+                BVec4A::new(b(4), b(5), b(6), b(7)),
+            ])
+        }
+        #[inline(always)]
+        pub fn bitmask(self) -> u32 {
+            self.0[0].bitmask() | self.0[1].bitmask() << 4
+        }
+        #[inline(always)]
+        pub fn and(self, o: M8) -> M8 {
+            M8([self.0[0] & o.0[0], self.0[1] & o.0[1]])
+        }
+        #[inline(always)]
+        pub fn or(self, o: M8) -> M8 {
+            M8([self.0[0] | o.0[0], self.0[1] | o.0[1]])
+        }
+        #[inline(always)]
+        pub fn and_not(self, o: M8) -> M8 {
+            M8([self.0[0] & !o.0[0], self.0[1] & !o.0[1]])
         }
     }
 }
 
-pub use imp::F8;
+pub use imp::{F8, M8};
+
+impl F8 {
+    #[inline(always)]
+    pub fn to_array(self) -> [f32; 8] {
+        let mut out = [0.0; 8];
+        self.store(&mut out);
+        out
+    }
+}
 
 #[cfg(test)]
 mod tests {
@@ -124,5 +241,46 @@ mod tests {
         let le = (0..8).filter(|&i| a[i] <= b[i]).fold(0, |m, i| m | 1 << i);
         assert_eq!(fa.le_mask(fb), le);
         assert_eq!(F8::splat(2.0).le_mask(F8::load(&a)), 0b0100_1100);
+    }
+
+    /// Each lane of the eight-lane ops is bitwise glam's four-lane op on it.
+    #[test]
+    fn lanes_match_glam() {
+        use glam::Vec4;
+        let a = [1.0, -2.0, 3.5, f32::INFINITY, 0.0, -0.0, 7.0, f32::NAN];
+        let b = [2.0, -3.0, 3.5, 1.0, -0.0, 0.0, f32::NEG_INFINITY, 1.0];
+        let (fa, fb) = (F8::load(&a), F8::load(&b));
+        let halves = |x: [f32; 8]| [Vec4::from_slice(&x[..4]), Vec4::from_slice(&x[4..])];
+        let (ga, gb) = (halves(a), halves(b));
+        let same = |got: F8, want: [Vec4; 2]| {
+            let got = got.to_array();
+            let want: Vec<f32> = want.iter().flat_map(|v| v.to_array()).collect();
+            (0..8).all(|i| got[i].to_bits() == want[i].to_bits())
+        };
+        let map = |f: fn(Vec4, Vec4) -> Vec4| [f(ga[0], gb[0]), f(ga[1], gb[1])];
+        assert!(same(fa.add(fb), map(|x, y| x + y)));
+        assert!(same(fa.div(fb), map(|x, y| x / y)));
+        assert!(same(fa.max(fb), map(Vec4::max)));
+        assert!(same(fa.min(fb), map(Vec4::min)));
+        assert!(same(fa.abs(), [ga[0].abs(), ga[1].abs()]));
+        let bits = |f: fn(Vec4, Vec4) -> u32| f(ga[0], gb[0]) | f(ga[1], gb[1]) << 4;
+        assert_eq!(fa.lt(fb).bitmask(), bits(|x, y| x.cmplt(y).bitmask()));
+        assert_eq!(fa.le(fb).bitmask(), bits(|x, y| x.cmple(y).bitmask()));
+        assert_eq!(fa.gt(fb).bitmask(), bits(|x, y| x.cmpgt(y).bitmask()));
+        assert_eq!(fa.eq(fb).bitmask(), bits(|x, y| x.cmpeq(y).bitmask()));
+        assert_eq!(fa.ne(fb).bitmask(), bits(|x, y| x.cmpne(y).bitmask()));
+        for m in [0, 1, 0b1010_0110, 0x80, 0xff] {
+            let mask = M8::from_bits(m);
+            assert_eq!(mask.bitmask(), m);
+            let sel = F8::select(mask, fa, fb).to_array();
+            assert!((0..8).all(|i| {
+                let want = if m >> i & 1 != 0 { a[i] } else { b[i] };
+                sel[i].to_bits() == want.to_bits()
+            }));
+            let other = M8::from_bits(0b0110_0011);
+            assert_eq!(mask.and(other).bitmask(), m & 0b0110_0011);
+            assert_eq!(mask.or(other).bitmask(), m | 0b0110_0011);
+            assert_eq!(mask.and_not(other).bitmask(), m & !0b0110_0011 & 0xff);
+        }
     }
 }

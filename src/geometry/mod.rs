@@ -3,9 +3,11 @@
 pub mod accel;
 mod bvh;
 mod lanes8;
+pub mod packet;
 mod refine;
 pub mod shape;
 pub mod watertight;
+mod watertight8;
 
 pub use accel::Accel;
 pub use shape::{Mesh, Shape, ShapeKind, Sphere};

@@ -10,7 +10,7 @@
 use glam::{BVec4A, Vec3, Vec3A, Vec4};
 
 /// pbrt-v4's gamma(n) for f32.
-const fn gamma(n: f32) -> f32 {
+pub(super) const fn gamma(n: f32) -> f32 {
     n * f32::EPSILON * 0.5 / (1.0 - n * f32::EPSILON * 0.5)
 }
 
@@ -18,7 +18,7 @@ const fn gamma(n: f32) -> f32 {
 /// each lane. Unused lanes repeat lane 0, so they can only report lane 0's hit again.
 #[derive(Clone, Copy, Debug)]
 pub struct Tri4 {
-    v: [[Vec4; 3]; 3],
+    pub(super) v: [[Vec4; 3]; 3],
 }
 
 impl Tri4 {
@@ -37,7 +37,7 @@ impl Tri4 {
         Tri4 { v }
     }
 
-    fn lane(&self, lane: usize) -> [Vec3A; 3] {
+    pub(super) fn lane(&self, lane: usize) -> [Vec3A; 3] {
         self.v
             .map(|p| Vec3A::new(p[0][lane], p[1][lane], p[2][lane]))
     }
@@ -46,17 +46,17 @@ impl Tri4 {
 /// Per-ray setup of the test.
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
-    o: Vec3A,
+    pub(super) o: Vec3A,
     /// The direction, for the f64 re-evaluation of hits too close for the f32 bound.
-    d: Vec3A,
+    pub(super) d: Vec3A,
     /// Dominant axis of the direction: which cyclic permutation maps it to z.
-    kz: u8,
+    pub(super) kz: u8,
     /// Source axis of the permuted frame's x, y and z.
-    axes: [usize; 3],
+    pub(super) axes: [usize; 3],
     /// Origin in the permuted frame, per lane.
-    o4: [Vec4; 3],
+    pub(super) o4: [Vec4; 3],
     /// (-d_x / d_z, -d_y / d_z, 1 / d_z) in the permuted frame, per lane.
-    shear: [Vec4; 3],
+    pub(super) shear: [Vec4; 3],
 }
 
 /// A packet hit: lane, distance and barycentrics (b1, b2) of vertices 1 and 2.
@@ -65,31 +65,20 @@ pub type LaneHit = (usize, f32, f32, f32);
 impl WatertightRay {
     #[inline(always)]
     pub fn new(o: Vec3, d: Vec3) -> Self {
-        let a = d.abs();
-        let kz = if a.x > a.y {
-            if a.x > a.z {
-                0
-            } else {
-                2
-            }
-        } else if a.y > a.z {
-            1
-        } else {
-            2
-        };
-        let axes = AXES[kz as usize];
-        // Arrays, not glam's Index: a runtime index into a Vec3 compiles to a branch chain.
-        let (oa, da) = (o.to_array(), d.to_array());
-        let dp = Vec3::new(da[axes[0]], da[axes[1]], da[axes[2]]);
+        let (kz, o_perm, shear) = setup(o, d);
+        Self::from_parts(o, d, kz, o_perm, shear)
+    }
+
+    /// The ray from `setup`'s results.
+    #[inline(always)]
+    pub(super) fn from_parts(o: Vec3, d: Vec3, kz: u8, o_perm: [f32; 3], shear: [f32; 3]) -> Self {
         WatertightRay {
             o: o.into(),
             d: d.into(),
             kz,
-            axes,
-            o4: axes.map(|i| Vec4::splat(oa[i])),
-            shear: crate::math::div3(Vec3::new(-dp.x, -dp.y, 1.0), dp.z)
-                .to_array()
-                .map(Vec4::splat),
+            axes: AXES[kz as usize],
+            o4: o_perm.map(Vec4::splat),
+            shear: shear.map(Vec4::splat),
         }
     }
 
@@ -212,8 +201,32 @@ impl WatertightRay {
     }
 }
 
+/// The per-ray set-up: the direction's dominant axis, the origin in the permuted frame, and
+/// (-d_x / d_z, -d_y / d_z, 1 / d_z) in that frame.
+#[inline(always)]
+pub(super) fn setup(o: Vec3, d: Vec3) -> (u8, [f32; 3], [f32; 3]) {
+    let a = d.abs();
+    let kz = if a.x > a.y {
+        if a.x > a.z {
+            0
+        } else {
+            2
+        }
+    } else if a.y > a.z {
+        1
+    } else {
+        2
+    };
+    let axes = AXES[kz as usize];
+    // Arrays, not glam's Index: a runtime index into a Vec3 compiles to a branch chain.
+    let (oa, da) = (o.to_array(), d.to_array());
+    let dp = Vec3::new(da[axes[0]], da[axes[1]], da[axes[2]]);
+    let shear = crate::math::div3(Vec3::new(-dp.x, -dp.y, 1.0), dp.z);
+    (kz, axes.map(|i| oa[i]), shear.to_array())
+}
+
 /// Source axes of the cyclic permutation that moves axis `kz` to z.
-const AXES: [[usize; 3]; 3] = [[1, 2, 0], [2, 0, 1], [0, 1, 2]];
+pub(super) const AXES: [[usize; 3]; 3] = [[1, 2, 0], [2, 0, 1], [0, 1, 2]];
 
 /// The watertight test for a single triangle: (t, b1, b2) of a hit inside (tmin, tmax).
 #[inline]

@@ -1,6 +1,7 @@
 //! The direct estimator for eight camera samples of a pixel at once, in vector lanes.
 //!
-//! Only the traversals stay one ray at a time. Everything between them (shading frames, light
+//! The camera rays and the shadow rays of the eight samples are traced as packets (see
+//! `geometry::packet`), the BSDF rays one at a time. Everything between them (shading frames, light
 //! points, densities, BSDF values, MIS weights, the shadow and BSDF rays) runs as loops over
 //! the eight samples, in structure-of-arrays form, which the compiler turns into vector code.
 //! Each loop body calls the same scalar functions as `Direct::li`, in the same order, so every
@@ -32,6 +33,9 @@ use crate::sampling::AliasTable;
 use crate::scene::desc::StrategyKind;
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
+
+// A pixel's eight samples trace their camera and shadow rays as one packet.
+const _: () = assert!(LANES == crate::geometry::packet::PACKET);
 
 /// Eight 3-vectors, one array per component.
 #[derive(Clone, Copy, Default)]
@@ -206,8 +210,9 @@ impl Direct<'_> {
         let scene = self.scene;
         let mut h = CameraHits::default();
         let mut batch = None;
+        let camera = scene.intersect8(rays, (1 << n) - 1);
         for i in 0..n {
-            let Some(hit) = scene.intersect(&rays[i]) else {
+            let Some(hit) = camera[i] else {
                 continue;
             };
             let sp = hit.sp;
@@ -377,25 +382,31 @@ impl Direct<'_> {
         o
     }
 
-    /// The traversals, one ray at a time, and the estimate of each covered lane, summed in
-    /// `li`'s order.
+    /// The traversals (the shadow rays as one packet, then the BSDF rays one at a time) and
+    /// the estimate of each covered lane, summed in `li`'s order.
     #[inline(always)]
     pub(super) fn trace_and_sum(&self, h: &CameraHits, sh: &Shaded, out: &mut [Rgb; LANES]) {
         let scene = self.scene;
         let s = &self.strategy;
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
         let bsdf_w = |pb, pl| heuristic(s.heuristic, nb * pb, ne * pl);
+        let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
+        let mut traced = 0u32;
+        for i in 0..LANES {
+            if h.l[i].is_some() && sh.light_ok[i] {
+                shadow[i] =
+                    Scene::shadow_ray_to(sh.shadow_o.get(i), sh.shadow_target.get(i), h.skip[i]);
+                traced |= 1 << i;
+            }
+        }
+        let blocked = scene.accel.occluded8(&shadow, traced);
         for i in 0..LANES {
             let Some(mut l) = h.l[i] else {
                 continue;
             };
             let mut light = Rgb::ZERO;
-            if sh.light_ok[i] {
-                let ray =
-                    Scene::shadow_ray_to(sh.shadow_o.get(i), sh.shadow_target.get(i), h.skip[i]);
-                if !scene.accel.occluded(&ray) {
-                    light = sh.light.get(i);
-                }
+            if traced >> i & 1 != 0 && blocked >> i & 1 == 0 {
+                light = sh.light.get(i);
             }
             l += light / ne;
             let mut bsdf = Rgb::ZERO;

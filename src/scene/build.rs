@@ -7,6 +7,7 @@ use crate::bsdf::{
 };
 use crate::camera::Camera;
 use crate::emitter::{AreaLight, Emitter, LightSample, PointLight};
+use crate::geometry::packet::PACKET;
 use crate::geometry::{Accel, Hit, Mesh, Ray, Shape, ShapeKind, Sphere, SurfacePoint, NO_SKIP};
 use crate::math::{offset_origin, Rgb};
 use crate::sampling::microfacet::Microfacet;
@@ -305,6 +306,12 @@ impl Scene {
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.accel.intersect(ray, &self.shapes)
+    }
+
+    /// `intersect` of each ray set in `active`, traced as one packet.
+    #[inline]
+    pub fn intersect8(&self, rays: &[Ray; PACKET], active: u32) -> [Option<Hit>; PACKET] {
+        self.accel.intersect8(rays, active, &self.shapes)
     }
 
     /// The closest hit if it lies on an emitter.

@@ -1,0 +1,490 @@
+//! Ray packets: up to eight rays (the camera or shadow rays of a pixel's eight samples)
+//! traced through the BVH together.
+//!
+//! One stack and one walk serve the packet: each node is fetched once and tested against
+//! every ray still in it (each ray with its own one-ray box test, so a ray enters exactly
+//! the children it would enter alone), and a leaf's triangles are tested one at a time
+//! against all its rays at once (`watertight8`) when the rays share a dominant axis, else
+//! ray by ray with the one-ray test. Both tests give a ray bitwise the same hit, so a
+//! packet's occlusion answers are those of `occluded`. Closest hits are too, except that two
+//! hits within f32's error bound of each other (a ray exactly through an edge shared by two
+//! leaves) may be visited in another order and resolved the other way, as by any other BVH.
+
+use super::accel::Accel;
+use super::bvh::{read, slab_inv, slab_test, Node, WideBvh, LEAF, ROBUST, STACK};
+use super::lanes8::{F8, M8};
+use super::shape::{intersect_sphere, ShapeKind};
+use super::watertight8::{Rays8, WatertightRay8};
+use super::{Hit, Ray, Shape};
+use glam::Vec2;
+use std::mem::MaybeUninit;
+
+/// Rays per packet.
+pub const PACKET: usize = 8;
+
+/// Iterates the set bits of a mask, lowest first.
+#[inline(always)]
+fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (m != 0).then(|| {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            i
+        })
+    })
+}
+
+/// Transposes an 8x8 bit matrix: bit 8r + c goes to bit 8c + r (Hacker's Delight 7-3).
+#[inline(always)]
+fn transpose8(mut x: u64) -> u64 {
+    let t = (x ^ (x >> 7)) & 0x00AA_00AA_00AA_00AA;
+    x ^= t ^ (t << 7);
+    let t = (x ^ (x >> 14)) & 0x0000_CCCC_0000_CCCC;
+    x ^= t ^ (t << 14);
+    let t = (x ^ (x >> 28)) & 0x0000_0000_F0F0_F0F0;
+    x ^ t ^ (t << 28)
+}
+
+/// The node test's set-up of a packet's rays: `BoxRay`'s, per ray.
+pub struct Boxes {
+    o: [[f32; 3]; PACKET],
+    inv: [[f32; 3]; PACKET],
+    near: [[usize; 3]; PACKET],
+    tmin: [f32; PACKET],
+}
+
+impl Boxes {
+    #[inline(always)]
+    pub fn new(rays: &[Ray; PACKET]) -> Self {
+        let mut b = Boxes {
+            o: [[0.0; 3]; PACKET],
+            inv: [[0.0; 3]; PACKET],
+            near: [[0; 3]; PACKET],
+            tmin: [0.0; PACKET],
+        };
+        for (i, r) in rays.iter().enumerate() {
+            let inv = slab_inv(r.d).to_array();
+            b.o[i] = r.o.to_array();
+            b.near[i] = [0, 1, 2].map(|a| 2 * a + inv[a].is_sign_negative() as usize);
+            b.inv[i] = inv;
+            b.tmin[i] = r.tmin;
+        }
+        b
+    }
+
+    /// Children of node `n` entered by the rays in `mask`: per child, the mask of rays
+    /// entering it (byte c of the result) and the nearest of their entry distances.
+    #[inline(always)]
+    fn enter(&self, n: &Node, mask: u32, tmax: &[f32; PACKET]) -> (u64, [f32; 8]) {
+        let mut by_ray = 0u64;
+        let mut key = F8::splat(f32::INFINITY);
+        for r in bits(mask) {
+            let (o, inv) = (self.o[r].map(F8::splat), self.inv[r].map(F8::splat));
+            let (m, tn) = slab_test(n, &o, &inv, self.near[r], F8::splat(self.tmin[r]), tmax[r]);
+            by_ray |= (m.bitmask() as u64) << (8 * r);
+            key = F8::select(m, key.min(tn), key);
+        }
+        (transpose8(by_ray), key.to_array())
+    }
+}
+
+impl WideBvh {
+    /// `closest` for the rays set in `active`: on return `tmax[i]` is ray i's closest hit
+    /// distance if it has one. `leaf(l, mask, tmax)` tests leaf `l` against the rays in
+    /// `mask`, lowering their `tmax` to the hits it finds.
+    #[inline(always)]
+    pub fn closest8<F: FnMut(usize, u32, &mut [f32; PACKET])>(
+        &self,
+        rays: &Boxes,
+        active: u32,
+        tmax: &mut [f32; PACKET],
+        mut leaf: F,
+    ) {
+        if self.nodes.is_empty() || active == 0 {
+            return;
+        }
+        let mut heap = Vec::new();
+        let mut local = [MaybeUninit::<(u32, u32, f32)>::uninit(); STACK];
+        let stack: &mut [_] = if self.stack_need <= STACK {
+            &mut local
+        } else {
+            heap.resize(self.stack_need, MaybeUninit::uninit());
+            &mut heap
+        };
+        let (mut sp, mut cur, mut cur_mask) = (0, 0u32, active);
+        loop {
+            if cur & LEAF == 0 {
+                let n = &self.nodes[cur as usize];
+                let (by_child, keys) = rays.enter(n, cur_mask, tmax);
+                if by_child != 0 {
+                    // Nearest next, the others farthest deepest, as in `closest`.
+                    let base = sp;
+                    for (c, key) in keys.into_iter().enumerate() {
+                        let m = (by_child >> (8 * c)) as u32 & 0xff;
+                        if m == 0 {
+                            continue;
+                        }
+                        let entry = (n.child[c], m, key);
+                        let mut k = sp;
+                        while k > base && unsafe { read(stack, k - 1) }.2 < entry.2 {
+                            stack[k] = stack[k - 1];
+                            k -= 1;
+                        }
+                        stack[k] = MaybeUninit::new(entry);
+                        sp += 1;
+                    }
+                    sp -= 1;
+                    (cur, cur_mask, _) = unsafe { read(stack, sp) };
+                    continue;
+                }
+            } else {
+                leaf((cur & !LEAF) as usize, cur_mask, tmax);
+            }
+            // Next waiting child with a ray whose closest hit may lie inside it.
+            loop {
+                if sp == 0 {
+                    return;
+                }
+                sp -= 1;
+                let (child, mask, key) = unsafe { read(stack, sp) };
+                let live = F8::splat(key).le_mask(F8::load(tmax).mul(F8::splat(ROBUST))) & mask;
+                if live != 0 {
+                    (cur, cur_mask) = (child, live);
+                    break;
+                }
+            }
+        }
+    }
+
+    /// `any` for the rays set in `active`: the mask of those for which `leaf(l, mask)`
+    /// reports a hit (it returns the mask of rays in `mask` it found blocked).
+    #[inline(always)]
+    pub fn any8<F: FnMut(usize, u32) -> u32>(
+        &self,
+        rays: &Boxes,
+        active: u32,
+        tmax: &[f32; PACKET],
+        mut leaf: F,
+    ) -> u32 {
+        if self.nodes.is_empty() || active == 0 {
+            return 0;
+        }
+        let mut heap = Vec::new();
+        let mut local = [MaybeUninit::<(u32, u32)>::uninit(); STACK];
+        let stack: &mut [_] = if self.stack_need <= STACK {
+            &mut local
+        } else {
+            heap.resize(self.stack_need, MaybeUninit::uninit());
+            &mut heap
+        };
+        let (mut sp, mut cur, mut cur_mask, mut done) = (0, 0u32, active, 0u32);
+        loop {
+            if cur & LEAF == 0 {
+                let n = &self.nodes[cur as usize];
+                let (by_child, _) = rays.enter(n, cur_mask, tmax);
+                for c in 0..8 {
+                    let m = (by_child >> (8 * c)) as u32 & 0xff;
+                    if m != 0 {
+                        stack[sp] = MaybeUninit::new((n.child[c], m));
+                        sp += 1;
+                    }
+                }
+            } else {
+                done |= leaf((cur & !LEAF) as usize, cur_mask);
+                if done == active {
+                    return done;
+                }
+            }
+            loop {
+                if sp == 0 {
+                    return done;
+                }
+                sp -= 1;
+                let (child, mask) = unsafe { read(stack, sp) };
+                if mask & !done != 0 {
+                    (cur, cur_mask) = (child, mask & !done);
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// A packet's per-ray set-up.
+struct Rays<'a> {
+    rays: &'a [Ray; PACKET],
+    boxes: Boxes,
+    tests: Rays8,
+    /// The eight-ray triangle test, if the active rays share a dominant axis.
+    wr8: Option<WatertightRay8>,
+    tmin: [f32; PACKET],
+    tmin8: F8,
+    skip: [u32; PACKET],
+}
+
+impl<'a> Rays<'a> {
+    #[inline(always)]
+    fn new(rays: &'a [Ray; PACKET], active: u32) -> Self {
+        let tests = Rays8::new(rays.map(|r| r.o), rays.map(|r| r.d));
+        let tmin = rays.map(|r| r.tmin);
+        Rays {
+            rays,
+            boxes: Boxes::new(rays),
+            wr8: tests.packet(active),
+            tests,
+            tmin,
+            tmin8: F8::load(&tmin),
+            skip: rays.map(|r| r.skip),
+        }
+    }
+
+    /// The eight-ray test for a leaf reached by the rays in `mask`, if it pays: with one or
+    /// two rays, the one-ray test (four triangles per instruction) is cheaper.
+    #[inline(always)]
+    fn wide(&self, mask: u32) -> Option<&WatertightRay8> {
+        self.wr8.as_ref().filter(|_| mask.count_ones() > 2)
+    }
+
+    /// Lanes of rays that skip triangle `id`.
+    #[inline(always)]
+    fn skipping(&self, id: u32) -> M8 {
+        let mut m = 0;
+        for (i, &s) in self.skip.iter().enumerate() {
+            m |= ((s == id) as u32) << i;
+        }
+        M8::from_bits(m)
+    }
+}
+
+impl Accel {
+    /// `intersect` for each ray set in `active`, traced as one packet.
+    pub fn intersect8(
+        &self,
+        rays: &[Ray; PACKET],
+        active: u32,
+        shapes: &[Shape],
+    ) -> [Option<Hit>; PACKET] {
+        let mut out = [None; PACKET];
+        if active.count_ones() <= 1 {
+            for i in bits(active) {
+                out[i] = self.intersect(&rays[i], shapes);
+            }
+            return out;
+        }
+        let r = Rays::new(rays, active);
+        let mut tmax = rays.map(|r| r.tmax);
+        // Per ray, the best primitive and its barycentrics.
+        let mut best = [(u32::MAX, Vec2::ZERO); PACKET];
+        self.bvh
+            .closest8(&r.boxes, active, &mut tmax, |l, mask, tmax| {
+                let leaf = &self.leaves[l];
+                if leaf.n_tris > 0 {
+                    if let Some(w8) = r.wide(mask) {
+                        // Tri4's `closest` per ray: the lowest t over the leaf, ties to the lowest
+                        // triangle, every triangle tested against the same tmax.
+                        let tmax8 = F8::load(tmax);
+                        let inf = F8::splat(f32::INFINITY);
+                        let (mut bt, mut bk, mut bb1, mut bb2) = (inf, inf, inf, inf);
+                        let mut any = 0;
+                        for k in 0..leaf.n_tris as usize {
+                            let skip = r.skipping(leaf.tri_ref[k]);
+                            let (hit, t, b1, b2) =
+                                w8.hits(&leaf.tris, k, r.tmin8, tmax8, mask, skip);
+                            if hit == 0 {
+                                continue;
+                            }
+                            let better = M8::from_bits(hit).and(t.lt(bt));
+                            bt = F8::select(better, t, bt);
+                            bk = F8::select(better, F8::splat(k as f32), bk);
+                            bb1 = F8::select(better, b1, bb1);
+                            bb2 = F8::select(better, b2, bb2);
+                            any |= hit;
+                        }
+                        let [bt, bk, bb1, bb2] = [bt, bk, bb1, bb2].map(F8::to_array);
+                        for i in bits(any) {
+                            tmax[i] = bt[i];
+                            best[i] = (leaf.tri_ref[bk[i] as usize], Vec2::new(bb1[i], bb2[i]));
+                        }
+                    } else {
+                        for i in bits(mask) {
+                            let skip = leaf.skip(r.skip[i]);
+                            if let Some((lane, t, b1, b2)) =
+                                r.tests.ray(i).closest(&leaf.tris, r.tmin[i], tmax[i], skip)
+                            {
+                                tmax[i] = t;
+                                best[i] = (leaf.tri_ref[lane], Vec2::new(b1, b2));
+                            }
+                        }
+                    }
+                }
+                for &(c, rad, id) in &self.spheres[leaf.spheres.0 as usize..leaf.spheres.1 as usize]
+                {
+                    for i in bits(mask) {
+                        let (o, d) = (r.rays[i].o, r.rays[i].d);
+                        if let Some(t) = intersect_sphere(o, d, r.tmin[i], tmax[i], c, rad) {
+                            tmax[i] = t;
+                            best[i] = (id, Vec2::ZERO);
+                        }
+                    }
+                }
+            });
+        for i in bits(active) {
+            // As `closest`: a hit only if it shortened the ray.
+            if best[i].0 == u32::MAX || !(tmax[i] < rays[i].tmax) {
+                continue;
+            }
+            let (shape, local) = self.refs[best[i].0 as usize];
+            let (o, d, t) = (rays[i].o, rays[i].d, tmax[i]);
+            let sp = match &shapes[shape as usize].kind {
+                ShapeKind::Mesh(m) => m.surface_point(local as usize, best[i].1, shape),
+                ShapeKind::Sphere(s) => s.surface_point(o + d * t, shape),
+            };
+            out[i] = Some(Hit { t, sp });
+        }
+        out
+    }
+
+    /// `occluded` for each ray set in `active`, traced as one packet: the mask of those blocked.
+    pub fn occluded8(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+        if active.count_ones() <= 1 {
+            return bits(active)
+                .filter(|&i| self.occluded(&rays[i]))
+                .fold(0, |m, i| m | 1 << i);
+        }
+        let r = Rays::new(rays, active);
+        let tmax = rays.map(|r| r.tmax);
+        let tmax8 = F8::load(&tmax);
+        self.bvh.any8(&r.boxes, active, &tmax, |l, mask| {
+            let leaf = &self.leaves[l];
+            let mut blocked = 0;
+            if leaf.n_tris > 0 {
+                if let Some(w8) = r.wide(mask) {
+                    for k in 0..leaf.n_tris as usize {
+                        let skip = r.skipping(leaf.tri_ref[k]);
+                        let open = mask & !blocked;
+                        blocked |= w8.hits(&leaf.tris, k, r.tmin8, tmax8, open, skip).0;
+                        if blocked == mask {
+                            return blocked;
+                        }
+                    }
+                } else {
+                    for i in bits(mask) {
+                        let skip = leaf.skip(r.skip[i]);
+                        if r.tests.ray(i).any(&leaf.tris, r.tmin[i], tmax[i], skip) {
+                            blocked |= 1 << i;
+                        }
+                    }
+                }
+            }
+            for &(c, rad, _) in &self.spheres[leaf.spheres.0 as usize..leaf.spheres.1 as usize] {
+                for i in bits(mask & !blocked) {
+                    let (o, d) = (r.rays[i].o, r.rays[i].d);
+                    if intersect_sphere(o, d, r.tmin[i], tmax[i], c, rad).is_some() {
+                        blocked |= 1 << i;
+                    }
+                }
+            }
+            blocked
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+    use glam::Vec3;
+
+    /// Up to eight rays as a packet and its active mask.
+    fn packet_of(rays: &[Ray]) -> ([Ray; PACKET], u32) {
+        let mut out = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
+        out[..rays.len()].copy_from_slice(rays);
+        (out, (1u32 << rays.len()) - 1)
+    }
+
+    #[test]
+    fn transpose8_moves_each_bit_to_its_mirror() {
+        for r in 0..8 {
+            for c in 0..8 {
+                assert_eq!(transpose8(1 << (8 * r + c)), 1 << (8 * c + r), "({r}, {c})");
+            }
+        }
+        let mut rng = Rng::new(3, 1);
+        for _ in 0..100 {
+            let x = (rng.next_f32().to_bits() as u64) << 32 | rng.next_f32().to_bits() as u64;
+            assert_eq!(transpose8(transpose8(x)), x);
+        }
+    }
+
+    /// Packets of coherent and of scattered rays, with and without a shared dominant axis,
+    /// get each ray's own closest hit and occlusion answer, bitwise, from the bundled Cornell
+    /// box's and Veach scene's geometry (triangles and spheres).
+    #[test]
+    fn packets_match_single_rays() {
+        for path in ["scenes/cbox/cbox.xml", "scenes/veach-mis/veach-mis.xml"] {
+            let desc = crate::scene::load_scene(std::path::Path::new(path), &[]).expect(path);
+            let scene = crate::scene::Scene::build(desc).expect(path);
+            let accel = &scene.accel;
+            let shapes = &scene.shapes;
+            let (lo, hi) = accel.bounds();
+            let mut rng = Rng::new(9, 9);
+            let mut u3 = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+            let (mut hits, mut blocked, mut wide) = (0, 0, 0);
+            for round in 0..3000 {
+                let n = 2 + round % 7;
+                let o = lo + (hi - lo) * u3();
+                let aim = lo + (hi - lo) * u3();
+                let spread = [0.001, 0.05, 1.0][round % 3];
+                let rays: Vec<Ray> = (0..n)
+                    .map(|i| {
+                        let target = aim + (hi - lo) * (u3() - 0.5) * spread;
+                        let mut ray = Ray::new(o + (hi - lo) * (u3() - 0.5) * 0.01, target - o);
+                        if round % 2 == 1 {
+                            // Shadow-ray style: a finite interval.
+                            ray.tmax = 1.0 - 1e-4;
+                        }
+                        if i % 3 == 2 {
+                            ray.tmin = 0.2;
+                        }
+                        ray
+                    })
+                    .collect();
+                let (packet, active) = packet_of(&rays);
+                let r = Rays::new(&packet, active);
+                wide += r.wr8.is_some() as u32;
+                let got = accel.intersect8(&packet, active, shapes);
+                let occluded = accel.occluded8(&packet, active);
+                for (i, ray) in rays.iter().enumerate() {
+                    let want = accel.intersect(ray, shapes);
+                    let key = |h: &Option<Hit>| {
+                        h.map(|h| {
+                            (
+                                h.t.to_bits(),
+                                h.sp.shape,
+                                h.sp.prim,
+                                h.sp.p.to_array().map(f32::to_bits),
+                            )
+                        })
+                    };
+                    assert_eq!(key(&got[i]), key(&want), "{path}: round {round}, ray {i}");
+                    let blocked_one = accel.occluded(ray);
+                    assert_eq!(
+                        occluded >> i & 1 != 0,
+                        blocked_one,
+                        "{path}: round {round}, ray {i}"
+                    );
+                    hits += want.is_some() as u32;
+                    blocked += blocked_one as u32;
+                }
+                assert_eq!(occluded >> n, 0);
+            }
+            // Every query counted here is a closest-hit and an occlusion query over the same
+            // interval, so the two counts agree.
+            assert_eq!(hits, blocked);
+            assert!(
+                hits > 2000 && wide > 1000,
+                "{path}: {hits} hits, {wide} wide packets"
+            );
+        }
+    }
+}
