@@ -7,7 +7,9 @@
 //! own light sampler, and BSDF rays drawn by the hit's own material. Like the renderer, the
 //! mix has no shadow ray for a light sample the BSDF or the light gives zero (below a one-sided
 //! surface's horizon, outside a narrow lobe) and no BSDF ray where the material draws none:
-//! rays the renderer never traces would count as traversal it does not do.
+//! rays the renderer never traces would count as traversal it does not do. The camera rays
+//! and the shadow rays of each pixel's groups of `LANES` samples are traced as packets, as
+//! the renderer traces them (`Scene::intersect8`, `Accel::occluded8`); BSDF rays one by one.
 
 use crate::emitter::{EmitterSelection, EmitterSelector, LightSampling};
 use crate::geometry::shape::intersect_sphere;
@@ -25,6 +27,41 @@ pub struct RayMix {
     /// Per camera ray, the index of its shadow ray and of its BSDF ray, if it has them: the
     /// order in which the renderer traces them.
     pub follow_ups: Vec<(Option<u32>, Option<u32>)>,
+    /// Per group of up to `LANES` samples of a pixel: its camera rays and its shadow rays as
+    /// the renderer's packets, with their active masks.
+    pub packets: Vec<Packets>,
+}
+
+pub struct Packets {
+    /// Index of the group's first camera ray.
+    pub first: usize,
+    pub camera: ([Ray; LANES], u32),
+    pub shadow: ([Ray; LANES], u32),
+}
+
+impl RayMix {
+    /// Groups the rays into the renderer's packets: `LANES` consecutive samples of a pixel.
+    fn pack(&mut self, spp: u32) {
+        let empty = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); LANES];
+        for pixel in (0..self.camera.len()).step_by(spp as usize) {
+            for g in (pixel..pixel + spp as usize).step_by(LANES) {
+                let mut p = Packets {
+                    first: g,
+                    camera: (empty, 0),
+                    shadow: (empty, 0),
+                };
+                for (lane, i) in (g..(g + LANES).min(pixel + spp as usize)).enumerate() {
+                    p.camera.0[lane] = self.camera[i];
+                    p.camera.1 |= 1 << lane;
+                    if let Some(s) = self.follow_ups[i].0 {
+                        p.shadow.0[lane] = self.shadow[s as usize];
+                        p.shadow.1 |= 1 << lane;
+                    }
+                }
+                self.packets.push(p);
+            }
+        }
+    }
 }
 
 /// The ray mix of `spp` samples per pixel of the scene's camera, emitters chosen by `selection`.
@@ -36,6 +73,7 @@ pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
         shadow: Vec::new(),
         bsdf: Vec::new(),
         follow_ups: Vec::new(),
+        packets: Vec::new(),
     };
     for y in 0..cam.height {
         for x in 0..cam.width {
@@ -71,6 +109,7 @@ pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
             }
         }
     }
+    mix.pack(spp);
     mix
 }
 
@@ -130,11 +169,12 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
     let (mut shares, mut shares_by_type) = (Vec::new(), Vec::new());
     let mut sink = 0usize;
     let prim = |h: Option<Hit>| h.map_or(0, |h| h.sp.prim as usize & 1);
+    let packet_prims = |h: [Option<Hit>; LANES]| h.into_iter().map(prim).sum::<usize>();
     let n = mix.camera.len() as f64;
     for _ in 0..repeat.max(1) {
         let t = Instant::now();
-        for r in &mix.camera {
-            sink += prim(scene.intersect(r));
+        for p in &mix.packets {
+            sink += packet_prims(scene.intersect8(&p.camera.0, p.camera.1));
         }
         let camera = t.elapsed().as_secs_f64();
         let t = Instant::now();
@@ -148,22 +188,16 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
         }
         let bsdf_query = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        for r in &mix.shadow {
-            sink += scene.accel.occluded(r) as usize;
+        for p in &mix.packets {
+            sink += scene.accel.occluded8(&p.shadow.0, p.shadow.1) as usize;
         }
         let occl = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        for g in (0..mix.camera.len()).step_by(LANES) {
-            let group = g..(g + LANES).min(mix.camera.len());
-            for i in group.clone() {
-                sink += prim(scene.intersect(&mix.camera[i]));
-            }
-            for i in group {
-                let (shadow, bsdf) = mix.follow_ups[i];
-                if let Some(s) = shadow {
-                    sink += scene.accel.occluded(&mix.shadow[s as usize]) as usize;
-                }
-                if let Some(b) = bsdf {
+        for p in &mix.packets {
+            sink += packet_prims(scene.intersect8(&p.camera.0, p.camera.1));
+            sink += scene.accel.occluded8(&p.shadow.0, p.shadow.1) as usize;
+            for i in (p.first..).take(p.camera.1.count_ones() as usize) {
+                if let Some(b) = mix.follow_ups[i].1 {
                     let (r, skip) = &mix.bsdf[b as usize];
                     sink += prim(scene.bsdf_ray_hit(r, *skip));
                 }
@@ -309,6 +343,38 @@ mod tests {
                 "a diffuse floor draws a BSDF ray per hit"
             );
         }
+    }
+
+    /// The packets are the renderer's: up to `LANES` consecutive samples of one pixel, each
+    /// camera ray in exactly one lane, each shadow ray in its camera ray's lane.
+    #[test]
+    fn packets_are_a_pixels_groups_of_samples() {
+        let scene = floor_and_light(false, None);
+        let spp = 12;
+        let mix = ray_mix(&scene, spp, EmitterSelection::Uniform);
+        let pixels = mix.camera.len() / spp as usize;
+        assert_eq!(mix.packets.len(), 2 * pixels, "a group of 8 and one of 4 per pixel");
+        let mut seen = vec![0; mix.camera.len()];
+        let mut shadows = 0;
+        for p in &mix.packets {
+            let n = p.camera.1.count_ones() as usize;
+            assert_eq!(p.camera.1, (1 << n) - 1);
+            assert_eq!(p.first / spp as usize, (p.first + n - 1) / spp as usize);
+            for lane in 0..n {
+                let i = p.first + lane;
+                seen[i] += 1;
+                assert_eq!(p.camera.0[lane].d, mix.camera[i].d);
+                let s = mix.follow_ups[i].0;
+                assert_eq!(p.shadow.1 >> lane & 1 != 0, s.is_some());
+                if let Some(s) = s {
+                    assert_eq!(p.shadow.0[lane].d, mix.shadow[s as usize].d);
+                    shadows += 1;
+                }
+            }
+        }
+        assert!(seen.iter().all(|&k| k == 1));
+        assert_eq!(shadows, mix.shadow.len());
+        assert!(shadows > 0);
     }
 
     /// On a rough conductor of roughness 0.01, BSDF rays leave within 8 degrees of the mirror
