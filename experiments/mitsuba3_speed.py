@@ -5,17 +5,25 @@ power-heuristic MIS: the bench's mis-power-e1b1 rows), render time only.
 
     pip install mitsuba            # 3.9.1 here; llvm_ad_rgb also needs: apt-get install libllvm19
     python3 experiments/mitsuba3_speed.py [--threads 2] [--spp 64] [--repeat 5]
+                                          [--directlab target/release/directlab]
 
 Prints one line per variant and scene and writes reports/bench/mitsuba3.csv (same columns as
 bench.csv). Each number is the best of --repeat renders; the JIT variant's first, compiling
 render is timed apart and not counted. Mitsuba needs 2 or more threads (with 1, writing an EXR
 hangs), so there is no 1-thread row.
+
+With --directlab, each Mitsuba render is followed by a directlab render of the same scene, spp,
+size and thread count with the same estimator (`mis-power-e1b1-uni-area`, its render time from
+--stats), and both best-of-N numbers are reported: on a shared VM whose speed drifts by tens of
+percent over minutes, only renders interleaved like this compare the two renderers fairly.
 """
 
 import argparse
 import csv
 import os
 import platform
+import json
+import subprocess
 import sys
 import tempfile
 import time
@@ -34,6 +42,21 @@ def cpu_model():
     return platform.processor() or "unknown CPU"
 
 
+def directlab_speed(a, path, sized):
+    """Samples/s of one directlab render (render time only, from its --stats)."""
+    with tempfile.TemporaryDirectory() as d:
+        cmd = [a.directlab, "render", path, "--spp", str(a.spp), "--threads", str(a.threads),
+               "--strategy", "mis", "--heuristic", "power", "--emitter-samples", "1",
+               "--bsdf-samples", "1", "--emitter-selection", "uniform",
+               "--light-sampling", "area", "--out", os.path.join(d, "img.exr"),
+               "--stats", os.path.join(d, "stats.json")]
+        if sized:
+            cmd += ["-D", f"res={a.res}"]
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        with open(os.path.join(d, "stats.json")) as f:
+            return json.load(f)["samples_per_second"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--threads", type=int, default=2)
@@ -42,6 +65,7 @@ def main():
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--variants", default="scalar_rgb,llvm_ad_rgb")
     ap.add_argument("--out", default="reports/bench/mitsuba3.csv")
+    ap.add_argument("--directlab", help="directlab binary to interleave with Mitsuba's renders")
     a = ap.parse_args()
     if a.threads < 2:
         sys.exit("mitsuba3_speed.py: --threads must be 2 or more (Mitsuba hangs with 1)")
@@ -68,13 +92,15 @@ def main():
             scene = mi.load_file(path, **params)
             film = scene.sensors()[0].film()
             n = film.size()[0] * film.size()[1] * a.spp
-            times = []
-            for _ in range(a.repeat + (1 if variant.startswith("llvm") else 0)):
+            times, ours = [], []
+            for k in range(a.repeat + (1 if variant.startswith("llvm") else 0)):
                 t = time.perf_counter()
                 img = mi.render(scene, spp=a.spp)
                 dr.eval(img)
                 dr.sync_thread()
                 times.append(time.perf_counter() - t)
+                if a.directlab and (k > 0 or not variant.startswith("llvm")):
+                    ours.append(directlab_speed(a, path, "res" in params))
             first = ""
             if variant.startswith("llvm"):
                 first = f" (first, compiling render {times[0]:.2f} s, not counted)"
@@ -89,6 +115,17 @@ def main():
             label = f"mitsuba3-{variant}-direct-e1b1"
             rows.append(("throughput", path, label, a.threads, 0, sps, "samples/s"))
             rows.append(("throughput_slowest", path, label, a.threads, 0, slowest, "samples/s"))
+            if ours:
+                print(
+                    f"  {'directlab':<12} {path:<32} {max(ours) / 1e6:7.2f} M samples/s, "
+                    f"slowest {min(ours) / 1e6:.2f} (interleaved with {variant}: "
+                    f"{max(ours) / sps:.2f}x its best)"
+                )
+                label = f"directlab-mis-power-e1b1-uni-area-interleaved-with-{variant}"
+                rows.append(("throughput", path, label, a.threads, 0, max(ours), "samples/s"))
+                rows.append(
+                    ("throughput_slowest", path, label, a.threads, 0, min(ours), "samples/s")
+                )
     os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=os.path.dirname(a.out) or ".", suffix=".tmp")
     with os.fdopen(fd, "w", newline="") as f:

@@ -19,49 +19,44 @@ use crate::rng::{Rng, LANES};
 use crate::scene::Scene;
 use std::time::Instant;
 
+/// The mix, each ray stored once, in the renderer's packets.
 pub struct RayMix {
-    pub camera: Vec<Ray>,
-    pub shadow: Vec<Ray>,
+    /// Per group of up to `LANES` consecutive samples of a pixel: its camera and shadow rays
+    /// as the renderer's packets, and each sample's BSDF ray.
+    pub packets: Vec<Packets>,
     /// BSDF rays with the triangle the emitter-only structure skips for them.
     pub bsdf: Vec<(Ray, u32)>,
-    /// Per camera ray, the index of its shadow ray and of its BSDF ray, if it has them: the
-    /// order in which the renderer traces them.
-    pub follow_ups: Vec<(Option<u32>, Option<u32>)>,
-    /// Per group of up to `LANES` samples of a pixel: its camera rays and its shadow rays as
-    /// the renderer's packets, with their active masks.
-    pub packets: Vec<Packets>,
+    pub n_camera: usize,
+    pub n_shadow: usize,
 }
 
 pub struct Packets {
-    /// Index of the group's first camera ray.
-    pub first: usize,
+    /// Rays and active-lane masks.
     pub camera: ([Ray; LANES], u32),
     pub shadow: ([Ray; LANES], u32),
+    /// Per lane, its BSDF ray's index in `RayMix::bsdf`, or `NONE`.
+    pub bsdf: [u32; LANES],
 }
 
+/// `Packets::bsdf` of a lane without a BSDF ray.
+pub const NONE: u32 = u32::MAX;
+
 impl RayMix {
-    /// Groups the rays into the renderer's packets: `LANES` consecutive samples of a pixel.
-    fn pack(&mut self, spp: u32) {
-        let empty = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); LANES];
-        for pixel in (0..self.camera.len()).step_by(spp as usize) {
-            for g in (pixel..pixel + spp as usize).step_by(LANES) {
-                let mut p = Packets {
-                    first: g,
-                    camera: (empty, 0),
-                    shadow: (empty, 0),
-                };
-                for (lane, i) in (g..(g + LANES).min(pixel + spp as usize)).enumerate() {
-                    p.camera.0[lane] = self.camera[i];
-                    p.camera.1 |= 1 << lane;
-                    if let Some(s) = self.follow_ups[i].0 {
-                        p.shadow.0[lane] = self.shadow[s as usize];
-                        p.shadow.1 |= 1 << lane;
-                    }
-                }
-                self.packets.push(p);
-            }
-        }
+    pub fn camera_rays(&self) -> impl Iterator<Item = &Ray> {
+        self.packets.iter().flat_map(|p| lanes(&p.camera))
     }
+
+    pub fn shadow_rays(&self) -> impl Iterator<Item = &Ray> {
+        self.packets.iter().flat_map(|p| lanes(&p.shadow))
+    }
+}
+
+/// The active rays of a packet.
+fn lanes((rays, mask): &([Ray; LANES], u32)) -> impl Iterator<Item = &Ray> {
+    rays.iter()
+        .enumerate()
+        .filter(move |(i, _)| mask >> i & 1 != 0)
+        .map(|(_, r)| r)
 }
 
 /// The ray mix of `spp` samples per pixel of the scene's camera, emitters chosen by `selection`.
@@ -69,23 +64,31 @@ pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
     let cam = &scene.camera;
     let selector = EmitterSelector::new(&scene.emitters, selection);
     let mut mix = RayMix {
-        camera: Vec::new(),
-        shadow: Vec::new(),
-        bsdf: Vec::new(),
-        follow_ups: Vec::new(),
         packets: Vec::new(),
+        bsdf: Vec::new(),
+        n_camera: 0,
+        n_shadow: 0,
     };
+    let empty = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); LANES];
     for y in 0..cam.height {
         for x in 0..cam.width {
             for s in 0..spp {
+                let lane = s as usize % LANES;
+                if lane == 0 {
+                    mix.packets.push(Packets {
+                        camera: (empty, 0),
+                        shadow: (empty, 0),
+                        bsdf: [NONE; LANES],
+                    });
+                }
+                let p = mix.packets.last_mut().expect("pushed above");
                 let mut rng = Rng::for_sample(7, (y * cam.width + x) as u64, s as u64);
                 let ray = cam.generate_ray(x, y, &mut rng);
-                mix.camera.push(ray);
-                mix.follow_ups.push((None, None));
+                (p.camera.0[lane], p.camera.1) = (ray, p.camera.1 | 1 << lane);
+                mix.n_camera += 1;
                 let Some(hit) = scene.intersect(&ray) else {
                     continue;
                 };
-                let follow = mix.follow_ups.last_mut().expect("pushed above");
                 let sp = hit.sp;
                 let frame = Frame::from_normal(sp.ns);
                 let wi = frame.to_local(-ray.d);
@@ -97,19 +100,19 @@ pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
                 }) {
                     let (f, _) = mat.eval_pdf(wi, frame.to_local(ls.wi));
                     if f != Rgb::ZERO && ls.li != Rgb::ZERO {
-                        follow.0 = Some(mix.shadow.len() as u32);
-                        mix.shadow.push(scene.shadow_ray(&sp, &ls));
+                        p.shadow.0[lane] = scene.shadow_ray(&sp, &ls);
+                        p.shadow.1 |= 1 << lane;
+                        mix.n_shadow += 1;
                     }
                 }
                 let u1 = rng.next_f32();
                 if let Some(bs) = mat.sample(wi, u1, rng.next_2d()) {
-                    follow.1 = Some(mix.bsdf.len() as u32);
+                    p.bsdf[lane] = mix.bsdf.len() as u32;
                     mix.bsdf.push(scene.bsdf_ray(&sp, frame.to_world(bs.wo)));
                 }
             }
         }
     }
-    mix.pack(spp);
     mix
 }
 
@@ -126,11 +129,11 @@ pub struct RayLimit {
 impl RayLimit {
     /// Rates from the best (closest-hit, occlusion) seconds for the whole mix.
     fn from_seconds(mix: &RayMix, best: (f64, f64)) -> RayLimit {
-        let n_closest = (mix.camera.len() + mix.bsdf.len()) as f64;
+        let n_closest = (mix.n_camera + mix.bsdf.len()) as f64;
         RayLimit {
             closest_per_s: n_closest / best.0,
-            occlusion_per_s: mix.shadow.len() as f64 / best.1,
-            seconds_per_sample: (best.0 + best.1) / mix.camera.len() as f64,
+            occlusion_per_s: mix.n_shadow as f64 / best.1,
+            seconds_per_sample: (best.0 + best.1) / mix.n_camera as f64,
         }
     }
 }
@@ -170,7 +173,7 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
     let mut sink = 0usize;
     let prim = |h: Option<Hit>| h.map_or(0, |h| h.sp.prim as usize & 1);
     let packet_prims = |h: [Option<Hit>; LANES]| h.into_iter().map(prim).sum::<usize>();
-    let n = mix.camera.len() as f64;
+    let n = mix.n_camera as f64;
     for _ in 0..repeat.max(1) {
         let t = Instant::now();
         for p in &mix.packets {
@@ -196,11 +199,9 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
         for p in &mix.packets {
             sink += packet_prims(scene.intersect8(&p.camera.0, p.camera.1));
             sink += scene.accel.occluded8(&p.shadow.0, p.shadow.1) as usize;
-            for i in (p.first..).take(p.camera.1.count_ones() as usize) {
-                if let Some(b) = mix.follow_ups[i].1 {
-                    let (r, skip) = &mix.bsdf[b as usize];
-                    sink += prim(scene.bsdf_ray_hit(r, *skip));
-                }
+            for &b in p.bsdf.iter().filter(|&&b| b != NONE) {
+                let (r, skip) = &mix.bsdf[b as usize];
+                sink += prim(scene.bsdf_ray_hit(r, *skip));
             }
         }
         let in_order = t.elapsed().as_secs_f64();
@@ -219,8 +220,8 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
     let [camera, bsdf_closest, bsdf_query, occl, in_order] = best;
     Limit {
         by_type: RayLimit {
-            closest_per_s: (mix.camera.len() + mix.bsdf.len()) as f64 / (camera + bsdf_closest),
-            occlusion_per_s: mix.shadow.len() as f64 / occl,
+            closest_per_s: (mix.n_camera + mix.bsdf.len()) as f64 / (camera + bsdf_closest),
+            occlusion_per_s: mix.n_shadow as f64 / occl,
             seconds_per_sample: (camera + bsdf_query + occl) / n,
         },
         bsdf_query_per_s: mix.bsdf.len() as f64 / bsdf_query,
@@ -277,13 +278,13 @@ pub fn measure_obvhs(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
     let mut sink = 0usize;
     for _ in 0..repeat.max(1) {
         let t = Instant::now();
-        for r in mix.camera.iter().chain(mix.bsdf.iter().map(|b| &b.0)) {
+        for r in mix.camera_rays().chain(mix.bsdf.iter().map(|b| &b.0)) {
             let mut hit = obvhs::ray::RayHit::none();
             sink += bvh.ray_traverse(ray(r), &mut hit, prim) as usize;
         }
         let closest = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        for r in &mix.shadow {
+        for r in mix.shadow_rays() {
             sink += !bvh.ray_traverse_miss(ray(r), prim) as usize;
         }
         let occl = t.elapsed().as_secs_f64();
@@ -330,13 +331,13 @@ mod tests {
             let scene = floor_and_light(below, None);
             let mix = ray_mix(&scene, 64, EmitterSelection::Uniform);
             let hits = mix
-                .camera
-                .iter()
+                .camera_rays()
                 .filter(|r| scene.intersect(r).is_some())
                 .count();
             assert_eq!(hits, 64, "the camera sees the floor");
             let expected = if below { 0 } else { hits };
-            assert_eq!(mix.shadow.len(), expected, "light below the floor: {below}");
+            assert_eq!(mix.n_shadow, expected, "light below the floor: {below}");
+            assert_eq!(mix.shadow_rays().count(), expected);
             assert_eq!(
                 mix.bsdf.len(),
                 hits,
@@ -345,35 +346,52 @@ mod tests {
         }
     }
 
-    /// The packets are the renderer's: up to `LANES` consecutive samples of one pixel, each
-    /// camera ray in exactly one lane, each shadow ray in its camera ray's lane.
+    /// The packets are the renderer's: up to `LANES` consecutive samples of one pixel (the
+    /// rays the camera makes for them, in order), each shadow and BSDF ray in its camera
+    /// ray's lane.
     #[test]
     fn packets_are_a_pixels_groups_of_samples() {
         let scene = floor_and_light(false, None);
         let spp = 12;
         let mix = ray_mix(&scene, spp, EmitterSelection::Uniform);
-        let pixels = mix.camera.len() / spp as usize;
-        assert_eq!(mix.packets.len(), 2 * pixels, "a group of 8 and one of 4 per pixel");
-        let mut seen = vec![0; mix.camera.len()];
-        let mut shadows = 0;
-        for p in &mix.packets {
-            let n = p.camera.1.count_ones() as usize;
+        let cam = &scene.camera;
+        let pixels = (cam.width * cam.height) as usize;
+        assert_eq!(
+            mix.packets.len(),
+            2 * pixels,
+            "a group of 8 and one of 4 per pixel"
+        );
+        assert_eq!(mix.n_camera, pixels * spp as usize);
+        let (mut shadows, mut bsdfs) = (0, 0);
+        for (k, p) in mix.packets.iter().enumerate() {
+            let (pixel, s0) = (k / 2, 8 * (k % 2) as u32);
+            let n = if k % 2 == 0 { 8 } else { 4 };
             assert_eq!(p.camera.1, (1 << n) - 1);
-            assert_eq!(p.first / spp as usize, (p.first + n - 1) / spp as usize);
             for lane in 0..n {
-                let i = p.first + lane;
-                seen[i] += 1;
-                assert_eq!(p.camera.0[lane].d, mix.camera[i].d);
-                let s = mix.follow_ups[i].0;
-                assert_eq!(p.shadow.1 >> lane & 1 != 0, s.is_some());
-                if let Some(s) = s {
-                    assert_eq!(p.shadow.0[lane].d, mix.shadow[s as usize].d);
-                    shadows += 1;
+                let (x, y) = (pixel as u32 % cam.width, pixel as u32 / cam.width);
+                let mut rng = Rng::for_sample(7, pixel as u64, (s0 + lane as u32) as u64);
+                assert_eq!(p.camera.0[lane].d, cam.generate_ray(x, y, &mut rng).d);
+                let hit = scene.intersect(&p.camera.0[lane]).is_some();
+                assert_eq!(
+                    p.shadow.1 >> lane & 1 != 0,
+                    hit,
+                    "the light is above the floor"
+                );
+                assert_eq!(
+                    p.bsdf[lane] != NONE,
+                    hit,
+                    "a diffuse floor draws a BSDF ray"
+                );
+                if hit {
+                    let b = &mix.bsdf[p.bsdf[lane] as usize].0;
+                    assert!(p.shadow.0[lane].o.distance(b.o) < 1e-3, "same hit point");
                 }
+                shadows += hit as usize;
+                bsdfs += hit as usize;
             }
+            assert_eq!(p.shadow.1 >> n, 0);
         }
-        assert!(seen.iter().all(|&k| k == 1));
-        assert_eq!(shadows, mix.shadow.len());
+        assert_eq!((shadows, bsdfs), (mix.n_shadow, mix.bsdf.len()));
         assert!(shadows > 0);
     }
 
@@ -394,7 +412,7 @@ mod tests {
         let scene = floor_and_light(false, Some(rough));
         let mix = ray_mix(&scene, 64, EmitterSelection::Uniform);
         assert_eq!(mix.bsdf.len(), 64);
-        for (c, b) in mix.camera.iter().zip(&mix.bsdf) {
+        for (c, b) in mix.camera_rays().zip(&mix.bsdf) {
             let mirror = Vec3::new(c.d.x, c.d.y, -c.d.z);
             let cos = b.0.d.normalize().dot(mirror.normalize());
             assert!(
