@@ -1,9 +1,10 @@
 //! The direct estimator for eight camera samples of a pixel at once, in vector lanes.
 //!
 //! The camera rays and the shadow rays of the eight samples are traced as packets (see
-//! `geometry::packet`), the BSDF rays one at a time. Everything between them (shading frames, light
-//! points, densities, BSDF values, MIS weights, the shadow and BSDF rays) runs as loops over
-//! the eight samples, in structure-of-arrays form, which the compiler turns into vector code.
+//! `geometry::packet`), the BSDF rays one at a time. Everything between them (shading frames,
+//! light points, densities, BSDF values, MIS weights, the shadow and BSDF rays) runs as loops
+//! over the eight samples, in structure-of-arrays form, which the compiler turns into vector
+//! code.
 //! Each loop body calls the same scalar functions as `Direct::li`, in the same order, so every
 //! sample is bitwise what `li` gives it (`render` tests this on the bundled scenes).
 //!
