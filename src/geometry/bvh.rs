@@ -44,7 +44,7 @@ pub struct WideBvh {
 }
 
 /// Per-ray data of the box test.
-pub(super) struct BoxRay {
+struct BoxRay {
     o: [F8; 3],
     inv: [F8; 3],
     /// Index into `Node::b` of each axis's near plane (by the direction's sign); the far one is
@@ -60,12 +60,19 @@ pub(super) fn slab_inv(d: Vec3) -> Vec3A {
     (Vec3A::ONE / Vec3A::from(d)).clamp(Vec3A::splat(-f32::MAX), Vec3A::splat(f32::MAX))
 }
 
+/// Index into `Node::b` of each axis's near plane for a ray with slab inverse `inv`: the
+/// min plane where the direction is positive, the max plane where it is negative.
+#[inline(always)]
+pub(super) fn near_planes(inv: Vec3A) -> [usize; 3] {
+    let neg = |x: f32| x.is_sign_negative() as usize;
+    [neg(inv.x), 2 + neg(inv.y), 4 + neg(inv.z)]
+}
+
 impl BoxRay {
     #[inline(always)]
-    pub(super) fn new(o: Vec3, d: Vec3, tmin: f32) -> Self {
+    fn new(o: Vec3, d: Vec3, tmin: f32) -> Self {
         let inv = slab_inv(d);
-        let neg = |x: f32| x.is_sign_negative() as usize;
-        let near = [neg(inv.x), 2 + neg(inv.y), 4 + neg(inv.z)];
+        let near = near_planes(inv);
         BoxRay {
             o: [F8::splat(o.x), F8::splat(o.y), F8::splat(o.z)],
             inv: [F8::splat(inv.x), F8::splat(inv.y), F8::splat(inv.z)],
@@ -83,7 +90,7 @@ impl BoxRay {
 
     /// `test` with its answers in lanes.
     #[inline(always)]
-    pub(super) fn test8(&self, n: &Node, tmax: f32) -> (M8, F8) {
+    fn test8(&self, n: &Node, tmax: f32) -> (M8, F8) {
         slab_test(n, &self.o, &self.inv, self.near, self.tmin, tmax)
     }
 }
@@ -109,6 +116,25 @@ pub(super) fn slab_test(
         .min(t(near[2] ^ 1, 2))
         .min(F8::splat(tmax));
     (tn.le(tf.mul(F8::splat(ROBUST))), tn)
+}
+
+/// Pushes `entry` onto a closest-hit traversal's stack of children waiting since `base`,
+/// keeping them farthest deepest by `key`; returns the new stack pointer.
+#[inline(always)]
+pub(super) fn push_by_distance<T: Copy>(
+    stack: &mut [MaybeUninit<T>],
+    base: usize,
+    sp: usize,
+    entry: T,
+    key: impl Fn(&T) -> f32,
+) -> usize {
+    let mut k = sp;
+    while k > base && key(&unsafe { read(stack, k - 1) }) < key(&entry) {
+        stack[k] = stack[k - 1];
+        k -= 1;
+    }
+    stack[k] = MaybeUninit::new(entry);
+    sp + 1
 }
 
 /// Entry `i` of a traversal stack.
@@ -302,13 +328,7 @@ impl WideBvh {
                         let lane = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
                         let entry = (n.child[lane], tn[lane]);
-                        let mut k = sp;
-                        while k > base && unsafe { read(stack, k - 1) }.1 < entry.1 {
-                            stack[k] = stack[k - 1];
-                            k -= 1;
-                        }
-                        stack[k] = MaybeUninit::new(entry);
-                        sp += 1;
+                        sp = push_by_distance(stack, base, sp, entry, |e| e.1);
                     }
                     sp -= 1;
                     cur = unsafe { read(stack, sp) }.0;

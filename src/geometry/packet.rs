@@ -11,7 +11,8 @@
 //! leaves) may be visited in another order and resolved the other way, as by any other BVH.
 
 use super::accel::Accel;
-use super::bvh::{read, slab_inv, slab_test, Node, WideBvh, LEAF, ROBUST, STACK};
+use super::bvh::{near_planes, push_by_distance, read, slab_inv, slab_test, Node, WideBvh};
+use super::bvh::{LEAF, ROBUST, STACK};
 use super::lanes8::{F8, M8};
 use super::shape::{intersect_sphere, ShapeKind};
 use super::watertight8::{Rays8, WatertightRay8};
@@ -45,7 +46,7 @@ fn transpose8(mut x: u64) -> u64 {
     x ^ t ^ (t << 28)
 }
 
-/// The node test's set-up of a packet's rays: `BoxRay`'s, per ray.
+/// The node test's set-up of a packet's rays: `BoxRay`'s, per ray, unsplatted.
 pub struct Boxes {
     o: [[f32; 3]; PACKET],
     inv: [[f32; 3]; PACKET],
@@ -63,10 +64,10 @@ impl Boxes {
             tmin: [0.0; PACKET],
         };
         for (i, r) in rays.iter().enumerate() {
-            let inv = slab_inv(r.d).to_array();
+            let inv = slab_inv(r.d);
             b.o[i] = r.o.to_array();
-            b.near[i] = [0, 1, 2].map(|a| 2 * a + inv[a].is_sign_negative() as usize);
-            b.inv[i] = inv;
+            b.near[i] = near_planes(inv);
+            b.inv[i] = inv.to_array();
             b.tmin[i] = r.tmin;
         }
         b
@@ -124,14 +125,7 @@ impl WideBvh {
                         if m == 0 {
                             continue;
                         }
-                        let entry = (n.child[c], m, key);
-                        let mut k = sp;
-                        while k > base && unsafe { read(stack, k - 1) }.2 < entry.2 {
-                            stack[k] = stack[k - 1];
-                            k -= 1;
-                        }
-                        stack[k] = MaybeUninit::new(entry);
-                        sp += 1;
+                        sp = push_by_distance(stack, base, sp, (n.child[c], m, key), |e| e.2);
                     }
                     sp -= 1;
                     (cur, cur_mask, _) = unsafe { read(stack, sp) };
@@ -217,24 +211,19 @@ struct Rays<'a> {
     tests: Rays8,
     /// The eight-ray triangle test, if the active rays share a dominant axis.
     wr8: Option<WatertightRay8>,
-    tmin: [f32; PACKET],
     tmin8: F8,
-    skip: [u32; PACKET],
 }
 
 impl<'a> Rays<'a> {
     #[inline(always)]
     fn new(rays: &'a [Ray; PACKET], active: u32) -> Self {
         let tests = Rays8::new(rays.map(|r| r.o), rays.map(|r| r.d));
-        let tmin = rays.map(|r| r.tmin);
         Rays {
             rays,
             boxes: Boxes::new(rays),
             wr8: tests.packet(active),
             tests,
-            tmin,
-            tmin8: F8::load(&tmin),
-            skip: rays.map(|r| r.skip),
+            tmin8: F8::load(&rays.map(|r| r.tmin)),
         }
     }
 
@@ -249,8 +238,8 @@ impl<'a> Rays<'a> {
     #[inline(always)]
     fn skipping(&self, id: u32) -> M8 {
         let mut m = 0;
-        for (i, &s) in self.skip.iter().enumerate() {
-            m |= ((s == id) as u32) << i;
+        for (i, r) in self.rays.iter().enumerate() {
+            m |= ((r.skip == id) as u32) << i;
         }
         M8::from_bits(m)
     }
@@ -307,9 +296,11 @@ impl Accel {
                         }
                     } else {
                         for i in bits(mask) {
-                            let skip = leaf.skip(r.skip[i]);
+                            let skip = leaf.skip(r.rays[i].skip);
                             if let Some((lane, t, b1, b2)) =
-                                r.tests.ray(i).closest(&leaf.tris, r.tmin[i], tmax[i], skip)
+                                r.tests
+                                    .ray(i)
+                                    .closest(&leaf.tris, r.rays[i].tmin, tmax[i], skip)
                             {
                                 tmax[i] = t;
                                 best[i] = (leaf.tri_ref[lane], Vec2::new(b1, b2));
@@ -320,8 +311,8 @@ impl Accel {
                 for &(c, rad, id) in &self.spheres[leaf.spheres.0 as usize..leaf.spheres.1 as usize]
                 {
                     for i in bits(mask) {
-                        let (o, d) = (r.rays[i].o, r.rays[i].d);
-                        if let Some(t) = intersect_sphere(o, d, r.tmin[i], tmax[i], c, rad) {
+                        let Ray { o, d, tmin, .. } = r.rays[i];
+                        if let Some(t) = intersect_sphere(o, d, tmin, tmax[i], c, rad) {
                             tmax[i] = t;
                             best[i] = (id, Vec2::ZERO);
                         }
@@ -369,8 +360,11 @@ impl Accel {
                     }
                 } else {
                     for i in bits(mask) {
-                        let skip = leaf.skip(r.skip[i]);
-                        if r.tests.ray(i).any(&leaf.tris, r.tmin[i], tmax[i], skip) {
+                        let skip = leaf.skip(r.rays[i].skip);
+                        if r.tests
+                            .ray(i)
+                            .any(&leaf.tris, r.rays[i].tmin, tmax[i], skip)
+                        {
                             blocked |= 1 << i;
                         }
                     }
@@ -378,8 +372,8 @@ impl Accel {
             }
             for &(c, rad, _) in &self.spheres[leaf.spheres.0 as usize..leaf.spheres.1 as usize] {
                 for i in bits(mask & !blocked) {
-                    let (o, d) = (r.rays[i].o, r.rays[i].d);
-                    if intersect_sphere(o, d, r.tmin[i], tmax[i], c, rad).is_some() {
+                    let Ray { o, d, tmin, .. } = r.rays[i];
+                    if intersect_sphere(o, d, tmin, tmax[i], c, rad).is_some() {
                         blocked |= 1 << i;
                     }
                 }

@@ -46,17 +46,17 @@ impl Tri4 {
 /// Per-ray setup of the test.
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
-    pub(super) o: Vec3A,
+    o: Vec3A,
     /// The direction, for the f64 re-evaluation of hits too close for the f32 bound.
-    pub(super) d: Vec3A,
+    d: Vec3A,
     /// Dominant axis of the direction: which cyclic permutation maps it to z.
-    pub(super) kz: u8,
+    kz: u8,
     /// Source axis of the permuted frame's x, y and z.
-    pub(super) axes: [usize; 3],
+    axes: [usize; 3],
     /// Origin in the permuted frame, per lane.
-    pub(super) o4: [Vec4; 3],
+    o4: [Vec4; 3],
     /// (-d_x / d_z, -d_y / d_z, 1 / d_z) in the permuted frame, per lane.
-    pub(super) shear: [Vec4; 3],
+    shear: [Vec4; 3],
 }
 
 /// A packet hit: lane, distance and barycentrics (b1, b2) of vertices 1 and 2.

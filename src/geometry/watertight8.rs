@@ -10,7 +10,7 @@
 use super::lanes8::{F8, M8};
 use super::refine::distance_f64;
 use super::watertight::{gamma, setup, Tri4, WatertightRay, AXES};
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
 
 /// Eight rays' set-up for either test: `WatertightRay`'s, per ray.
 pub struct Rays8 {
@@ -72,8 +72,8 @@ impl Rays8 {
             F8::load(&x)
         }
         Some(WatertightRay8 {
-            o: [0, 1, 2].map(|k| lanes(|i| self.o[i][k])),
-            d: [0, 1, 2].map(|k| lanes(|i| self.d[i][k])),
+            o: self.o,
+            d: self.d,
             kz,
             axes: AXES[kz as usize],
             o8: [0, 1, 2].map(|k| lanes(|i| self.o_perm[i][k])),
@@ -85,9 +85,9 @@ impl Rays8 {
 /// Eight rays that share a dominant axis, one per lane.
 #[derive(Clone, Copy)]
 pub struct WatertightRay8 {
-    /// Origin and direction (for the f64 re-evaluation).
-    o: [F8; 3],
-    d: [F8; 3],
+    /// Per ray, origin and direction (for the f64 re-evaluation).
+    o: [Vec3; 8],
+    d: [Vec3; 8],
     kz: u8,
     axes: [usize; 3],
     /// Origin in the permuted frame.
@@ -195,14 +195,13 @@ impl WatertightRay8 {
     #[inline(never)]
     fn refine(&self, tri: &Tri4, k: usize, unsure: u32, t: &mut F8, tmin: F8, tmax: F8) -> u32 {
         let (mut ts, lo, hi) = (t.to_array(), tmin.to_array(), tmax.to_array());
-        let (o, d) = (self.o.map(F8::to_array), self.d.map(F8::to_array));
         let mut hit = 0;
         let mut m = unsure;
         while m != 0 {
             let l = m.trailing_zeros() as usize;
             m &= m - 1;
-            let lane = |v: &[[f32; 8]; 3]| Vec3A::new(v[0][l], v[1][l], v[2][l]);
-            let exact = distance_f64(lane(&o), lane(&d), self.kz, tri.lane(k));
+            let (o, d) = (self.o[l].into(), self.d[l].into());
+            let exact = distance_f64(o, d, self.kz, tri.lane(k));
             if let Some(x) = exact.filter(|&x| x > lo[l] as f64 && x < hi[l] as f64) {
                 ts[l] = x as f32;
                 hit |= 1 << l;
