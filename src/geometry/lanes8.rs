@@ -59,6 +59,16 @@ mod imp {
         pub fn abs(self) -> F8 {
             F8(unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0) })
         }
+        /// Flips the sign bit, as scalar negation.
+        #[inline(always)]
+        pub fn neg(self) -> F8 {
+            F8(unsafe { _mm256_xor_ps(_mm256_set1_ps(-0.0), self.0) })
+        }
+        /// Bit i set where lane i's sign bit is (-0.0 and negative NaNs included).
+        #[inline(always)]
+        pub fn sign_mask(self) -> u32 {
+            unsafe { _mm256_movemask_ps(self.0) as u32 }
+        }
         // Ordered predicates, false for NaN, as SSE's cmplt/cmple/cmpgt/cmpeq; cmpneq is
         // unordered (true for NaN), as SSE's.
         cmp!(lt, _CMP_LT_OS);
@@ -159,6 +169,14 @@ mod imp {
         #[inline(always)]
         pub fn abs(self) -> F8 {
             F8([self.0[0].abs(), self.0[1].abs()])
+        }
+        #[inline(always)]
+        pub fn neg(self) -> F8 {
+            F8([-self.0[0], -self.0[1]])
+        }
+        #[inline(always)]
+        pub fn sign_mask(self) -> u32 {
+            self.0[0].is_negative_bitmask() | self.0[1].is_negative_bitmask() << 4
         }
         cmp!(lt, cmplt);
         cmp!(le, cmple);
@@ -263,6 +281,10 @@ mod tests {
         assert!(same(fa.max(fb), map(Vec4::max)));
         assert!(same(fa.min(fb), map(Vec4::min)));
         assert!(same(fa.abs(), [ga[0].abs(), ga[1].abs()]));
+        assert!(same(fa.neg(), [-ga[0], -ga[1]]));
+        let signs = ga[0].is_negative_bitmask() | ga[1].is_negative_bitmask() << 4;
+        assert_eq!(fa.sign_mask(), signs);
+        assert_eq!(F8::load(&b).sign_mask(), 0b0101_0010, "-3, -0 and -inf");
         let bits = |f: fn(Vec4, Vec4) -> u32| f(ga[0], gb[0]) | f(ga[1], gb[1]) << 4;
         assert_eq!(fa.lt(fb).bitmask(), bits(|x, y| x.cmplt(y).bitmask()));
         assert_eq!(fa.le(fb).bitmask(), bits(|x, y| x.cmple(y).bitmask()));

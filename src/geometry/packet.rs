@@ -11,13 +11,13 @@
 //! leaves) may be visited in another order and resolved the other way, as by any other BVH.
 
 use super::accel::Accel;
-use super::bvh::{near_planes, push_by_distance, read, slab_inv, slab_test, Node, WideBvh};
+use super::bvh::{push_by_distance, read, slab_test, Node, WideBvh};
 use super::bvh::{LEAF, ROBUST, STACK};
 use super::lanes8::{F8, M8};
 use super::shape::{intersect_sphere, ShapeKind};
 use super::watertight8::{Rays8, WatertightRay8};
 use super::{Hit, Ray, Shape};
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use std::mem::MaybeUninit;
 
 /// Rays per packet.
@@ -46,11 +46,14 @@ fn transpose8(mut x: u64) -> u64 {
     x ^ t ^ (t << 28)
 }
 
-/// The node test's set-up of a packet's rays: `BoxRay`'s, per ray, unsplatted.
+/// The node test's set-up of a packet's rays: `BoxRay`'s, per ray, computed in lanes (the
+/// same IEEE division and clamp per lane as `slab_inv`).
 pub struct Boxes {
-    o: [[f32; 3]; PACKET],
-    inv: [[f32; 3]; PACKET],
-    near: [[usize; 3]; PACKET],
+    o: [[f32; PACKET]; 3],
+    inv: [[f32; PACKET]; 3],
+    /// Per axis, the rays whose slab inverse is negative: their near plane is the max plane
+    /// (`near_planes`).
+    neg: [u32; 3],
     tmin: [f32; PACKET],
 }
 
@@ -58,19 +61,33 @@ impl Boxes {
     #[inline(always)]
     pub fn new(rays: &[Ray; PACKET]) -> Self {
         let mut b = Boxes {
-            o: [[0.0; 3]; PACKET],
-            inv: [[0.0; 3]; PACKET],
-            near: [[0; 3]; PACKET],
+            o: [[0.0; PACKET]; 3],
+            inv: [[0.0; PACKET]; 3],
+            neg: [0; 3],
             tmin: [0.0; PACKET],
         };
+        let mut d = [[0.0; PACKET]; 3];
+        // Loops, not `array::map`: its closures were not inlined here.
         for (i, r) in rays.iter().enumerate() {
-            let inv = slab_inv(r.d);
-            b.o[i] = r.o.to_array();
-            b.near[i] = near_planes(inv);
-            b.inv[i] = inv.to_array();
+            (b.o[0][i], b.o[1][i], b.o[2][i]) = (r.o.x, r.o.y, r.o.z);
+            (d[0][i], d[1][i], d[2][i]) = (r.d.x, r.d.y, r.d.z);
             b.tmin[i] = r.tmin;
         }
+        for (a, d) in d.iter().enumerate() {
+            let inv = F8::splat(1.0)
+                .div(F8::load(d))
+                .max(F8::splat(-f32::MAX))
+                .min(F8::splat(f32::MAX));
+            inv.store(&mut b.inv[a]);
+            b.neg[a] = inv.sign_mask();
+        }
         b
+    }
+
+    /// Ray r's near planes, as `near_planes` gives them.
+    #[inline(always)]
+    fn near(&self, r: usize) -> [usize; 3] {
+        [0, 1, 2].map(|a| 2 * a + (self.neg[a] >> r & 1) as usize)
     }
 
     /// Children of node `n` entered by the rays in `mask`: per child, the mask of rays
@@ -80,8 +97,9 @@ impl Boxes {
         let mut by_ray = 0u64;
         let mut key = F8::splat(f32::INFINITY);
         for r in bits(mask) {
-            let (o, inv) = (self.o[r].map(F8::splat), self.inv[r].map(F8::splat));
-            let (m, tn) = slab_test(n, &o, &inv, self.near[r], F8::splat(self.tmin[r]), tmax[r]);
+            let o = [0, 1, 2].map(|a| F8::splat(self.o[a][r]));
+            let inv = [0, 1, 2].map(|a| F8::splat(self.inv[a][r]));
+            let (m, tn) = slab_test(n, &o, &inv, self.near(r), F8::splat(self.tmin[r]), tmax[r]);
             by_ray |= (m.bitmask() as u64) << (8 * r);
             key = F8::select(m, key.min(tn), key);
         }
@@ -209,29 +227,33 @@ struct Rays<'a> {
     rays: &'a [Ray; PACKET],
     boxes: Boxes,
     tests: Rays8,
-    /// The eight-ray triangle test, if the active rays share a dominant axis.
-    wr8: Option<WatertightRay8>,
+    /// The packet's active rays, for the eight-ray triangle test.
+    active: u32,
     tmin8: F8,
 }
 
 impl<'a> Rays<'a> {
     #[inline(always)]
     fn new(rays: &'a [Ray; PACKET], active: u32) -> Self {
-        let tests = Rays8::new(rays.map(|r| r.o), rays.map(|r| r.d));
+        let (mut o, mut d, mut tmin) = ([Vec3::ZERO; PACKET], [Vec3::ZERO; PACKET], [0.0; 8]);
+        for (i, r) in rays.iter().enumerate() {
+            (o[i], d[i], tmin[i]) = (r.o, r.d, r.tmin);
+        }
         Rays {
             rays,
             boxes: Boxes::new(rays),
-            wr8: tests.packet(active),
-            tests,
-            tmin8: F8::load(&rays.map(|r| r.tmin)),
+            tests: Rays8::new(o, d),
+            active,
+            tmin8: F8::load(&tmin),
         }
     }
 
-    /// The eight-ray test for a leaf reached by the rays in `mask`, if it pays: with one or
-    /// two rays, the one-ray test (four triangles per instruction) is cheaper.
+    /// The eight-ray test for a leaf reached by the rays in `mask`, if the packet's rays share
+    /// a dominant axis and it pays: with one or two rays, the one-ray test (four triangles per
+    /// instruction) is cheaper.
     #[inline(always)]
-    fn wide(&self, mask: u32) -> Option<&WatertightRay8> {
-        self.wr8.as_ref().filter(|_| mask.count_ones() > 2)
+    fn wide(&self, mask: u32) -> Option<WatertightRay8<'_>> {
+        (mask.count_ones() > 2).then(|| self.tests.packet(self.active))?
     }
 
     /// Lanes of rays that skip triangle `id`.
@@ -284,7 +306,8 @@ impl Accel {
                             }
                             let better = M8::from_bits(hit).and(t.lt(bt));
                             bt = F8::select(better, t, bt);
-                            bk = F8::select(better, F8::splat(k as f32), bk);
+                            // The triangle's number as a bit pattern: selects move it exactly.
+                            bk = F8::select(better, F8::splat(f32::from_bits(k as u32)), bk);
                             bb1 = F8::select(better, b1, bb1);
                             bb2 = F8::select(better, b2, bb2);
                             any |= hit;
@@ -292,7 +315,8 @@ impl Accel {
                         let [bt, bk, bb1, bb2] = [bt, bk, bb1, bb2].map(F8::to_array);
                         for i in bits(any) {
                             tmax[i] = bt[i];
-                            best[i] = (leaf.tri_ref[bk[i] as usize], Vec2::new(bb1[i], bb2[i]));
+                            let k = bk[i].to_bits() as usize;
+                            best[i] = (leaf.tri_ref[k], Vec2::new(bb1[i], bb2[i]));
                         }
                     } else {
                         for i in bits(mask) {
@@ -396,6 +420,44 @@ mod tests {
         (out, (1u32 << rays.len()) - 1)
     }
 
+    /// The packet's box set-up in lanes is bitwise the one-ray set-up (`slab_inv`,
+    /// `near_planes`) of each ray, also for zero, negative zero, tiny (1/d overflows to the
+    /// clamp) and infinite direction components.
+    #[test]
+    fn box_set_up_is_the_one_ray_set_up() {
+        use super::super::bvh::{near_planes, slab_inv};
+        let mut rng = Rng::new(5, 1);
+        let special = [
+            0.0,
+            -0.0,
+            1e-39,
+            -1e-39,
+            f32::INFINITY,
+            -f32::INFINITY,
+            1e-3,
+            -2.0,
+        ];
+        for round in 0..500 {
+            let rays: [Ray; PACKET] = std::array::from_fn(|i| {
+                let mut c = [0; 3].map(|_| rng.next_f32() * 2.0 - 1.0);
+                c[(round + i) % 3] = special[(round * 3 + i) % special.len()];
+                let o = Vec3::new(rng.next_f32(), -rng.next_f32(), rng.next_f32() * 9.0);
+                Ray {
+                    tmin: rng.next_f32(),
+                    ..Ray::new(o, Vec3::from_array(c))
+                }
+            });
+            let b = Boxes::new(&rays);
+            for (i, r) in rays.iter().enumerate() {
+                let inv = slab_inv(r.d).to_array().map(f32::to_bits);
+                assert_eq!([0, 1, 2].map(|a| b.inv[a][i].to_bits()), inv, "{:?}", r.d);
+                assert_eq!(b.near(i), near_planes(slab_inv(r.d)), "{:?}", r.d);
+                assert_eq!([0, 1, 2].map(|a| b.o[a][i]), r.o.to_array());
+                assert_eq!(b.tmin[i], r.tmin);
+            }
+        }
+    }
+
     #[test]
     fn transpose8_moves_each_bit_to_its_mirror() {
         for r in 0..8 {
@@ -445,7 +507,7 @@ mod tests {
                     .collect();
                 let (packet, active) = packet_of(&rays);
                 let r = Rays::new(&packet, active);
-                wide += r.wr8.is_some() as u32;
+                wide += r.wide(active).is_some() as u32;
                 let got = accel.intersect8(&packet, active, shapes);
                 let occluded = accel.occluded8(&packet, active);
                 for (i, ray) in rays.iter().enumerate() {

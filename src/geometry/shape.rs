@@ -90,7 +90,7 @@ impl Mesh {
     /// The surface point at barycentrics (b1, b2) of a triangle. The position is recomputed
     /// from the vertices, which keeps its rounding error proportional to the vertices' size
     /// rather than to the ray's length.
-    #[inline]
+    #[inline(always)]
     pub fn surface_point(&self, tri: usize, b: Vec2, shape: u32) -> SurfacePoint {
         let (v, normals) = (self.vertices(tri), self.vertex_normals(tri));
         Mesh::point_from(v, self.face[tri], normals, b, shape, tri as u32)

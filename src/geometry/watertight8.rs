@@ -9,32 +9,65 @@
 
 use super::lanes8::{F8, M8};
 use super::refine::distance_f64;
-use super::watertight::{gamma, setup, Tri4, WatertightRay, AXES};
+use super::watertight::{gamma, Tri4, WatertightRay, AXES};
 use glam::Vec3;
 
-/// Eight rays' set-up for either test: `WatertightRay`'s, per ray.
+/// Eight rays' set-up for either test: `WatertightRay`'s, per ray, computed in lanes.
 pub struct Rays8 {
     o: [Vec3; 8],
     d: [Vec3; 8],
-    kz: [u8; 8],
-    o_perm: [[f32; 3]; 8],
-    shear: [[f32; 3]; 8],
+    /// Rays whose dominant axis is x, y, z (`setup`'s kz), as bit masks.
+    kz_bits: [u32; 3],
+    /// Per permuted axis, per ray: the origin and the shear.
+    o_perm: [[f32; 8]; 3],
+    shear: [[f32; 8]; 3],
 }
 
 impl Rays8 {
+    /// `setup` for eight rays at once: the same comparisons pick the dominant axis, selects
+    /// (exact) permute, and the divisions are the same IEEE divisions, so each ray's set-up is
+    /// bitwise `setup`'s.
     #[inline(always)]
     pub fn new(o: [Vec3; 8], d: [Vec3; 8]) -> Self {
+        let (mut os, mut ds) = ([[0.0; 8]; 3], [[0.0; 8]; 3]);
+        // Loops, not `array::map`: its closures were not inlined here.
+        for i in 0..8 {
+            (os[0][i], os[1][i], os[2][i]) = (o[i].x, o[i].y, o[i].z);
+            (ds[0][i], ds[1][i], ds[2][i]) = (d[i].x, d[i].y, d[i].z);
+        }
+        let ov = [F8::load(&os[0]), F8::load(&os[1]), F8::load(&os[2])];
+        let dv = [F8::load(&ds[0]), F8::load(&ds[1]), F8::load(&ds[2])];
+        let [ax, ay, az] = [dv[0].abs(), dv[1].abs(), dv[2].abs()];
+        // kz = 0 where a.x > a.y and a.x > a.z; 1 where not a.x > a.y and a.y > a.z; else 2.
+        let x_gt_y = ax.gt(ay);
+        let kz0 = x_gt_y.and(ax.gt(az));
+        let kz1 = ay.gt(az).and_not(x_gt_y);
+        let (b0, b1) = (kz0.bitmask(), kz1.bitmask());
+        // AXES: kz 0 takes (y, z, x), kz 1 takes (z, x, y), kz 2 takes (x, y, z).
+        let pick = |v: &[F8; 3], k0: usize, k1: usize, k2: usize| {
+            F8::select(kz0, v[k0], F8::select(kz1, v[k1], v[k2]))
+        };
         let mut r = Rays8 {
             o,
             d,
-            kz: [0; 8],
-            o_perm: [[0.0; 3]; 8],
-            shear: [[0.0; 3]; 8],
+            kz_bits: [b0, b1, !(b0 | b1) & 0xff],
+            o_perm: [[0.0; 8]; 3],
+            shear: [[0.0; 8]; 3],
         };
-        for i in 0..8 {
-            (r.kz[i], r.o_perm[i], r.shear[i]) = setup(o[i], d[i]);
+        for (k, (k0, k1, k2)) in [(1, 2, 0), (2, 0, 1), (0, 1, 2)].into_iter().enumerate() {
+            pick(&ov, k0, k1, k2).store(&mut r.o_perm[k]);
         }
+        let (dx, dy, dz) = (pick(&dv, 1, 2, 0), pick(&dv, 2, 0, 1), pick(&dv, 0, 1, 2));
+        dx.neg().div(dz).store(&mut r.shear[0]);
+        dy.neg().div(dz).store(&mut r.shear[1]);
+        F8::splat(1.0).div(dz).store(&mut r.shear[2]);
         r
+    }
+
+    /// Ray i's dominant axis.
+    #[inline(always)]
+    fn kz(&self, i: usize) -> u8 {
+        (0..3).find(|&k| self.kz_bits[k] >> i & 1 != 0).unwrap_or(2) as u8
     }
 
     /// Ray i's one-ray test: bitwise `WatertightRay::new` of it.
@@ -43,51 +76,37 @@ impl Rays8 {
         WatertightRay::from_parts(
             self.o[i],
             self.d[i],
-            self.kz[i],
-            self.o_perm[i],
-            self.shear[i],
+            self.kz(i),
+            self.o_perm.map(|a| a[i]),
+            self.shear.map(|a| a[i]),
         )
     }
 
     /// The rays set in `active` as one eight-ray test, if they share a dominant axis.
     #[inline(always)]
-    pub fn packet(&self, active: u32) -> Option<WatertightRay8> {
+    pub fn packet(&self, active: u32) -> Option<WatertightRay8<'_>> {
         if active == 0 {
             return None;
         }
-        let kz = self.kz[active.trailing_zeros() as usize];
-        let mut same = true;
-        for i in 0..8 {
-            same &= active >> i & 1 == 0 || self.kz[i] == kz;
-        }
-        if !same {
-            return None;
-        }
-        #[inline(always)]
-        fn lanes(f: impl Fn(usize) -> f32) -> F8 {
-            let mut x = [0.0; 8];
-            for (i, x) in x.iter_mut().enumerate() {
-                *x = f(i);
-            }
-            F8::load(&x)
-        }
+        let kz = (0..3).find(|&k| active & !self.kz_bits[k] == 0)?;
         Some(WatertightRay8 {
-            o: self.o,
-            d: self.d,
-            kz,
-            axes: AXES[kz as usize],
-            o8: [0, 1, 2].map(|k| lanes(|i| self.o_perm[i][k])),
-            shear: [0, 1, 2].map(|k| lanes(|i| self.shear[i][k])),
+            o: &self.o,
+            d: &self.d,
+            kz: kz as u8,
+            axes: AXES[kz],
+            o8: self.o_perm.map(|a| F8::load(&a)),
+            shear: self.shear.map(|a| F8::load(&a)),
         })
     }
 }
 
 /// Eight rays that share a dominant axis, one per lane.
 #[derive(Clone, Copy)]
-pub struct WatertightRay8 {
-    /// Per ray, origin and direction (for the f64 re-evaluation).
-    o: [Vec3; 8],
-    d: [Vec3; 8],
+pub struct WatertightRay8<'a> {
+    /// Per ray, origin and direction (for the f64 re-evaluation), borrowed from the set-up:
+    /// copied, they were a fifth of a camera packet's set-up.
+    o: &'a [Vec3; 8],
+    d: &'a [Vec3; 8],
     kz: u8,
     axes: [usize; 3],
     /// Origin in the permuted frame.
@@ -99,7 +118,7 @@ pub struct WatertightRay8 {
 /// Per lane: hit mask, distance and barycentrics (b1, b2) of vertices 1 and 2.
 pub type Hits8 = (u32, F8, F8, F8);
 
-impl WatertightRay8 {
+impl WatertightRay8<'_> {
     /// Triangle `k` of the packet `tri` against the rays in `active`, strictly inside each
     /// ray's (tmin, tmax); lanes in `skip` never hit. The hit mask only has `active` lanes.
     #[inline(always)]
@@ -217,6 +236,60 @@ mod tests {
     use super::*;
     use crate::rng::Rng;
     use glam::BVec4A;
+
+    /// Each ray's set-up in lanes is bitwise the one-ray `setup`, for every dominant axis,
+    /// ties between axes (which `setup` breaks by its comparison order), zero and negative
+    /// zero components, and packets that mix axes.
+    #[test]
+    fn lane_set_up_is_the_one_ray_set_up() {
+        use crate::geometry::watertight::setup;
+        let mut rng = Rng::new(3, 9);
+        let mut f = || rng.next_f32() * 4.0 - 2.0;
+        let special = [0.0, -0.0, 1.0, -1.0, 0.5, -0.5];
+        let mut axes_seen = [0; 3];
+        for round in 0..2000 {
+            let o: [Vec3; 8] = std::array::from_fn(|_| Vec3::new(f(), f(), f()));
+            let d: [Vec3; 8] = std::array::from_fn(|i| {
+                let mut c = [f(), f(), f()];
+                // Ties and zeros: copy or pick special values for some components.
+                match (round + i) % 5 {
+                    0 => c[1] = -c[0],
+                    1 => c[2] = c[1],
+                    2 => c[(round + i) % 3] = special[(round * 7 + i) % special.len()],
+                    3 => c = [c[0], c[0], -c[0]],
+                    _ => {}
+                }
+                Vec3::from_array(c)
+            });
+            let set = Rays8::new(o, d);
+            for i in 0..8 {
+                let (kz, op, sh) = setup(o[i], d[i]);
+                axes_seen[kz as usize] += 1;
+                assert_eq!(set.kz(i), kz, "round {round}, ray {i}: {:?}", d[i]);
+                let bits = |a: [f32; 3]| a.map(f32::to_bits);
+                assert_eq!(
+                    bits(set.o_perm.map(|a| a[i])),
+                    bits(op),
+                    "round {round}, ray {i}"
+                );
+                assert_eq!(
+                    bits(set.shear.map(|a| a[i])),
+                    bits(sh),
+                    "round {round}, ray {i}"
+                );
+            }
+            for active in [0xff, 0x0f, 0x81, 0b0110_0000, 1 << (round % 8)] {
+                let mut kz = (0..8)
+                    .filter(|i| active >> i & 1 != 0)
+                    .map(|i| setup(o[i], d[i]).0);
+                let k0 = kz.next();
+                let shared = k0.filter(|&k| kz.all(|k2| k2 == k));
+                let got = set.packet(active).map(|p| p.kz);
+                assert_eq!(got, shared, "round {round}, active {active:#b}");
+            }
+        }
+        assert!(axes_seen.iter().all(|&n| n > 2000), "{axes_seen:?}");
+    }
 
     /// Per ray and triangle, the eight-ray test's hit, distance and barycentrics are bitwise
     /// the four-lane test's, also for rays through shared edges and vertices, rays whose hit
