@@ -32,6 +32,22 @@ impl Leaf {
     }
 }
 
+/// The surface point of a closest hit at distance `t` along `ray`: on primitive
+/// `(shape, local index)` at barycentrics `b` (a triangle) or projected onto it (a sphere).
+#[inline(always)]
+pub(super) fn surface_point(
+    shapes: &[Shape],
+    (shape, local): (u32, u32),
+    b: Vec2,
+    ray: &Ray,
+    t: f32,
+) -> SurfacePoint {
+    match &shapes[shape as usize].kind {
+        ShapeKind::Mesh(m) => m.surface_point(local as usize, b, shape),
+        ShapeKind::Sphere(s) => s.surface_point(ray.o + ray.d * t, shape),
+    }
+}
+
 pub struct Accel {
     pub(super) bvh: WideBvh,
     pub(super) leaves: Vec<Leaf>,
@@ -207,15 +223,14 @@ impl Accel {
                 tmax
             },
         )?;
-        let (shape, local) = self.refs[best.0 as usize];
-        if !keep(shape as usize) {
+        let prim = self.refs[best.0 as usize];
+        if !keep(prim.0 as usize) {
             return None;
         }
-        let sp = match &shapes[shape as usize].kind {
-            ShapeKind::Mesh(m) => m.surface_point(local as usize, best.1, shape),
-            ShapeKind::Sphere(s) => s.surface_point(ray.o + ray.d * t, shape),
-        };
-        Some(Hit { t, sp })
+        Some(Hit {
+            t,
+            sp: surface_point(shapes, prim, best.1, ray, t),
+        })
     }
 
     /// The box around everything in the structure.

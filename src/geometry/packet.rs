@@ -10,14 +10,14 @@
 //! hits within f32's error bound of each other (a ray exactly through an edge shared by two
 //! leaves) may be visited in another order and resolved the other way, as by any other BVH.
 
-use super::accel::Accel;
+use super::accel::{surface_point, Accel};
 use super::bvh::{push_by_distance, read, slab_test, Node, WideBvh};
 use super::bvh::{LEAF, ROBUST, STACK};
 use super::lanes8::{F8, M8};
-use super::shape::{intersect_sphere, ShapeKind};
-use super::watertight8::{Rays8, WatertightRay8};
+use super::shape::intersect_sphere;
+use super::watertight8::{Lanes3, Rays8, WatertightRay8};
 use super::{Hit, Ray, Shape};
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 use std::mem::MaybeUninit;
 
 /// Rays per packet.
@@ -59,20 +59,13 @@ pub struct Boxes {
 
 impl Boxes {
     #[inline(always)]
-    pub fn new(rays: &[Ray; PACKET]) -> Self {
+    pub fn new(o: &Lanes3, d: &Lanes3, tmin: &[f32; PACKET]) -> Self {
         let mut b = Boxes {
-            o: [[0.0; PACKET]; 3],
+            o: *o,
             inv: [[0.0; PACKET]; 3],
             neg: [0; 3],
-            tmin: [0.0; PACKET],
+            tmin: *tmin,
         };
-        let mut d = [[0.0; PACKET]; 3];
-        // Loops, not `array::map`: its closures were not inlined here.
-        for (i, r) in rays.iter().enumerate() {
-            (b.o[0][i], b.o[1][i], b.o[2][i]) = (r.o.x, r.o.y, r.o.z);
-            (d[0][i], d[1][i], d[2][i]) = (r.d.x, r.d.y, r.d.z);
-            b.tmin[i] = r.tmin;
-        }
         for (a, d) in d.iter().enumerate() {
             let inv = F8::splat(1.0)
                 .div(F8::load(d))
@@ -222,6 +215,19 @@ impl WideBvh {
     }
 }
 
+/// A packet's origins, directions (by axis) and tmins: transposed once, for both set-ups.
+#[inline(always)]
+fn by_axis(rays: &[Ray; PACKET]) -> (Lanes3, Lanes3, [f32; PACKET]) {
+    let (mut o, mut d, mut tmin) = ([[0.0; PACKET]; 3], [[0.0; PACKET]; 3], [0.0; PACKET]);
+    // Loops, not `array::map`: its closures were not inlined here.
+    for (i, r) in rays.iter().enumerate() {
+        (o[0][i], o[1][i], o[2][i]) = (r.o.x, r.o.y, r.o.z);
+        (d[0][i], d[1][i], d[2][i]) = (r.d.x, r.d.y, r.d.z);
+        tmin[i] = r.tmin;
+    }
+    (o, d, tmin)
+}
+
 /// A packet's per-ray set-up.
 struct Rays<'a> {
     rays: &'a [Ray; PACKET],
@@ -229,23 +235,23 @@ struct Rays<'a> {
     tests: Rays8,
     /// The packet's active rays, for the eight-ray triangle test.
     active: u32,
-    tmin8: F8,
 }
 
 impl<'a> Rays<'a> {
     #[inline(always)]
     fn new(rays: &'a [Ray; PACKET], active: u32) -> Self {
-        let (mut o, mut d, mut tmin) = ([Vec3::ZERO; PACKET], [Vec3::ZERO; PACKET], [0.0; 8]);
-        for (i, r) in rays.iter().enumerate() {
-            (o[i], d[i], tmin[i]) = (r.o, r.d, r.tmin);
-        }
+        let (o, d, tmin) = by_axis(rays);
         Rays {
             rays,
-            boxes: Boxes::new(rays),
-            tests: Rays8::new(o, d),
+            boxes: Boxes::new(&o, &d, &tmin),
+            tests: Rays8::new(&o, &d),
             active,
-            tmin8: F8::load(&tmin),
         }
+    }
+
+    #[inline(always)]
+    fn tmin8(&self) -> F8 {
+        F8::load(&self.boxes.tmin)
     }
 
     /// The eight-ray test for a leaf reached by the rays in `mask`, if the packet's rays share
@@ -253,7 +259,11 @@ impl<'a> Rays<'a> {
     /// instruction) is cheaper.
     #[inline(always)]
     fn wide(&self, mask: u32) -> Option<WatertightRay8<'_>> {
-        (mask.count_ones() > 2).then(|| self.tests.packet(self.active))?
+        if mask.count_ones() > 2 {
+            self.tests.packet(self.active)
+        } else {
+            None
+        }
     }
 
     /// Lanes of rays that skip triangle `id`.
@@ -283,6 +293,7 @@ impl Accel {
             return out;
         }
         let r = Rays::new(rays, active);
+        let tmin8 = r.tmin8();
         let mut tmax = rays.map(|r| r.tmax);
         // Per ray, the best primitive and its barycentrics.
         let mut best = [(u32::MAX, Vec2::ZERO); PACKET];
@@ -299,8 +310,7 @@ impl Accel {
                         let mut any = 0;
                         for k in 0..leaf.n_tris as usize {
                             let skip = r.skipping(leaf.tri_ref[k]);
-                            let (hit, t, b1, b2) =
-                                w8.hits(&leaf.tris, k, r.tmin8, tmax8, mask, skip);
+                            let (hit, t, b1, b2) = w8.hits(&leaf.tris, k, tmin8, tmax8, mask, skip);
                             if hit == 0 {
                                 continue;
                             }
@@ -348,12 +358,14 @@ impl Accel {
             if best[i].0 == u32::MAX || !(tmax[i] < rays[i].tmax) {
                 continue;
             }
-            let (shape, local) = self.refs[best[i].0 as usize];
-            let (o, d, t) = (rays[i].o, rays[i].d, tmax[i]);
-            let sp = match &shapes[shape as usize].kind {
-                ShapeKind::Mesh(m) => m.surface_point(local as usize, best[i].1, shape),
-                ShapeKind::Sphere(s) => s.surface_point(o + d * t, shape),
-            };
+            let t = tmax[i];
+            let sp = surface_point(
+                shapes,
+                self.refs[best[i].0 as usize],
+                best[i].1,
+                &rays[i],
+                t,
+            );
             out[i] = Some(Hit { t, sp });
         }
         out
@@ -368,7 +380,7 @@ impl Accel {
         }
         let r = Rays::new(rays, active);
         let tmax = rays.map(|r| r.tmax);
-        let tmax8 = F8::load(&tmax);
+        let (tmin8, tmax8) = (r.tmin8(), F8::load(&tmax));
         self.bvh.any8(&r.boxes, active, &tmax, |l, mask| {
             let leaf = &self.leaves[l];
             let mut blocked = 0;
@@ -377,7 +389,7 @@ impl Accel {
                     for k in 0..leaf.n_tris as usize {
                         let skip = r.skipping(leaf.tri_ref[k]);
                         let open = mask & !blocked;
-                        blocked |= w8.hits(&leaf.tris, k, r.tmin8, tmax8, open, skip).0;
+                        blocked |= w8.hits(&leaf.tris, k, tmin8, tmax8, open, skip).0;
                         if blocked == mask {
                             return blocked;
                         }
@@ -447,7 +459,8 @@ mod tests {
                     ..Ray::new(o, Vec3::from_array(c))
                 }
             });
-            let b = Boxes::new(&rays);
+            let (o, d, tmin) = by_axis(&rays);
+            let b = Boxes::new(&o, &d, &tmin);
             for (i, r) in rays.iter().enumerate() {
                 let inv = slab_inv(r.d).to_array().map(f32::to_bits);
                 assert_eq!([0, 1, 2].map(|a| b.inv[a][i].to_bits()), inv, "{:?}", r.d);

@@ -4,23 +4,26 @@
 //! do not take `watertight`'s one-ray test instead.
 //!
 //! Every lane runs the four-lane test's IEEE operations in the same order on the same inputs
-//! (the per-ray set-up is `WatertightRay`'s own, gathered), so a ray's answer here is bitwise
-//! its answer there, and a renderer may switch between the two per packet.
+//! (the per-ray set-up, computed in lanes, is bitwise `WatertightRay`'s), so a ray's answer
+//! here is bitwise its answer there, and a renderer may switch between the two per packet.
 
 use super::lanes8::{F8, M8};
 use super::refine::distance_f64;
 use super::watertight::{gamma, Tri4, WatertightRay, AXES};
 use glam::Vec3;
 
+/// Eight 3-vectors by axis: `v[a][i]` is component a of vector i.
+pub type Lanes3 = [[f32; 8]; 3];
+
 /// Eight rays' set-up for either test: `WatertightRay`'s, per ray, computed in lanes.
 pub struct Rays8 {
-    o: [Vec3; 8],
-    d: [Vec3; 8],
+    o: Lanes3,
+    d: Lanes3,
     /// Rays whose dominant axis is x, y, z (`setup`'s kz), as bit masks.
     kz_bits: [u32; 3],
     /// Per permuted axis, per ray: the origin and the shear.
-    o_perm: [[f32; 8]; 3],
-    shear: [[f32; 8]; 3],
+    o_perm: Lanes3,
+    shear: Lanes3,
 }
 
 impl Rays8 {
@@ -28,36 +31,31 @@ impl Rays8 {
     /// (exact) permute, and the divisions are the same IEEE divisions, so each ray's set-up is
     /// bitwise `setup`'s.
     #[inline(always)]
-    pub fn new(o: [Vec3; 8], d: [Vec3; 8]) -> Self {
-        let (mut os, mut ds) = ([[0.0; 8]; 3], [[0.0; 8]; 3]);
-        // Loops, not `array::map`: its closures were not inlined here.
-        for i in 0..8 {
-            (os[0][i], os[1][i], os[2][i]) = (o[i].x, o[i].y, o[i].z);
-            (ds[0][i], ds[1][i], ds[2][i]) = (d[i].x, d[i].y, d[i].z);
-        }
-        let ov = [F8::load(&os[0]), F8::load(&os[1]), F8::load(&os[2])];
-        let dv = [F8::load(&ds[0]), F8::load(&ds[1]), F8::load(&ds[2])];
+    pub fn new(o: &Lanes3, d: &Lanes3) -> Self {
+        let ov = [F8::load(&o[0]), F8::load(&o[1]), F8::load(&o[2])];
+        let dv = [F8::load(&d[0]), F8::load(&d[1]), F8::load(&d[2])];
         let [ax, ay, az] = [dv[0].abs(), dv[1].abs(), dv[2].abs()];
         // kz = 0 where a.x > a.y and a.x > a.z; 1 where not a.x > a.y and a.y > a.z; else 2.
         let x_gt_y = ax.gt(ay);
         let kz0 = x_gt_y.and(ax.gt(az));
         let kz1 = ay.gt(az).and_not(x_gt_y);
         let (b0, b1) = (kz0.bitmask(), kz1.bitmask());
-        // AXES: kz 0 takes (y, z, x), kz 1 takes (z, x, y), kz 2 takes (x, y, z).
-        let pick = |v: &[F8; 3], k0: usize, k1: usize, k2: usize| {
-            F8::select(kz0, v[k0], F8::select(kz1, v[k1], v[k2]))
+        // Permuted axis k of each lane: `AXES[kz][k]` of the source.
+        let perm = |v: &[F8; 3], k: usize| {
+            let src = |kz: usize| v[AXES[kz][k]];
+            F8::select(kz0, src(0), F8::select(kz1, src(1), src(2)))
         };
         let mut r = Rays8 {
-            o,
-            d,
+            o: *o,
+            d: *d,
             kz_bits: [b0, b1, !(b0 | b1) & 0xff],
             o_perm: [[0.0; 8]; 3],
             shear: [[0.0; 8]; 3],
         };
-        for (k, (k0, k1, k2)) in [(1, 2, 0), (2, 0, 1), (0, 1, 2)].into_iter().enumerate() {
-            pick(&ov, k0, k1, k2).store(&mut r.o_perm[k]);
+        for k in 0..3 {
+            perm(&ov, k).store(&mut r.o_perm[k]);
         }
-        let (dx, dy, dz) = (pick(&dv, 1, 2, 0), pick(&dv, 2, 0, 1), pick(&dv, 0, 1, 2));
+        let (dx, dy, dz) = (perm(&dv, 0), perm(&dv, 1), perm(&dv, 2));
         dx.neg().div(dz).store(&mut r.shear[0]);
         dy.neg().div(dz).store(&mut r.shear[1]);
         F8::splat(1.0).div(dz).store(&mut r.shear[2]);
@@ -74,8 +72,8 @@ impl Rays8 {
     #[inline(always)]
     pub fn ray(&self, i: usize) -> WatertightRay {
         WatertightRay::from_parts(
-            self.o[i],
-            self.d[i],
+            lane(&self.o, i),
+            lane(&self.d, i),
             self.kz(i),
             self.o_perm.map(|a| a[i]),
             self.shear.map(|a| a[i]),
@@ -100,13 +98,19 @@ impl Rays8 {
     }
 }
 
+/// Vector i of eight by axis.
+#[inline(always)]
+fn lane(v: &Lanes3, i: usize) -> Vec3 {
+    Vec3::new(v[0][i], v[1][i], v[2][i])
+}
+
 /// Eight rays that share a dominant axis, one per lane.
 #[derive(Clone, Copy)]
 pub struct WatertightRay8<'a> {
     /// Per ray, origin and direction (for the f64 re-evaluation), borrowed from the set-up:
     /// copied, they were a fifth of a camera packet's set-up.
-    o: &'a [Vec3; 8],
-    d: &'a [Vec3; 8],
+    o: &'a Lanes3,
+    d: &'a Lanes3,
     kz: u8,
     axes: [usize; 3],
     /// Origin in the permuted frame.
@@ -219,7 +223,7 @@ impl WatertightRay8<'_> {
         while m != 0 {
             let l = m.trailing_zeros() as usize;
             m &= m - 1;
-            let (o, d) = (self.o[l].into(), self.d[l].into());
+            let (o, d) = (lane(self.o, l).into(), lane(self.d, l).into());
             let exact = distance_f64(o, d, self.kz, tri.lane(k));
             if let Some(x) = exact.filter(|&x| x > lo[l] as f64 && x < hi[l] as f64) {
                 ts[l] = x as f32;
@@ -236,6 +240,10 @@ mod tests {
     use super::*;
     use crate::rng::Rng;
     use glam::BVec4A;
+
+    fn by_axis(v: [Vec3; 8]) -> Lanes3 {
+        [0, 1, 2].map(|a| v.map(|v| v[a]))
+    }
 
     /// Each ray's set-up in lanes is bitwise the one-ray `setup`, for every dominant axis,
     /// ties between axes (which `setup` breaks by its comparison order), zero and negative
@@ -261,7 +269,7 @@ mod tests {
                 }
                 Vec3::from_array(c)
             });
-            let set = Rays8::new(o, d);
+            let set = Rays8::new(&by_axis(o), &by_axis(d));
             for i in 0..8 {
                 let (kz, op, sh) = setup(o[i], d[i]);
                 axes_seen[kz as usize] += 1;
@@ -316,7 +324,7 @@ mod tests {
             });
             let rays: [WatertightRay; 8] = dirs.map(|d| WatertightRay::new(o, d));
             let active = (round as u32 * 37) & 0xff | 1;
-            let set = Rays8::new([o; 8], dirs);
+            let set = Rays8::new(&by_axis([o; 8]), &by_axis(dirs));
             let Some(r8) = set.packet(active) else {
                 continue;
             };
