@@ -45,6 +45,7 @@ fn bench_writes_every_section() {
         "of render time outside traversal",
         "raw obvhs",
         "growth over",
+        "machine limit: 2 independent 1-thread renders",
         "machine: ",
         "cbox.xml: 16x16",
     ] {
@@ -95,6 +96,8 @@ fn bench_writes_every_section() {
     );
     assert_eq!(sections["thread_scaling"], strategies, "{sections:?}");
     assert_eq!(sections["thread_busy"], strategies, "{sections:?}");
+    // Two independent 1-thread renders against one, once per scene.
+    assert_eq!(sections["machine_scaling"], 1, "{sections:?}");
     assert_eq!(
         sections["thread_work_per_sample"], strategies,
         "{sections:?}"

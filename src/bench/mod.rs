@@ -1,9 +1,11 @@
 //! `directlab bench`: speed goals as measured numbers (printed and written to
 //! `reports/bench/bench.csv`), never timed tests. Sections: render throughput per scene,
-//! strategy and thread count; the ray-tracing limit for the same ray mix and the share of
+//! strategy and thread count; the machine's own scaling (independent 1-thread renders side by
+//! side); the ray-tracing limit for the same ray mix and the share of
 //! render time spent outside traversal; per-sample cost as the triangle and emitter counts
 //! grow; peak memory.
 
+mod copies;
 mod raylimit;
 mod scaling;
 
@@ -264,6 +266,8 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         let name = path.display().to_string();
         // `res` sets the size of scenes that declare it; the others keep their own.
         println!("  {name}: {}x{}", scene.camera.width, scene.camera.height);
+        // The first strategy's thread speed-up, read against the machine's own below.
+        let mut first_speed_up = None;
         for strategy in bench_strategies() {
             let all = throughputs(&scene, strategy, a.spp, &a.threads, a.repeat);
             let by_threads: Vec<(usize, Timed)> = a.threads.iter().copied().zip(all).collect();
@@ -299,6 +303,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             if let (Some(&(t1, s1)), Some(&(t2, s2))) = (lo, hi) {
                 if t2 > t1 {
                     let speed_up = s2.samples_per_s / s1.samples_per_s;
+                    first_speed_up.get_or_insert((t2, speed_up));
                     let work = s2.work_per_sample / s1.work_per_sample;
                     println!(
                         "  {:<34} {:<26} {:>7} {:>11.2}x  (workers busy {:.1}%, work per sample {:.3}x the {t1}-thread's)",
@@ -326,6 +331,26 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                     }
                 }
             }
+        }
+        if let Some((t2, speed_up)) = first_speed_up {
+            let mis = bench_strategies()[0];
+            let c = copies::measure(&scene, mis, a.spp, t2, a.repeat);
+            println!(
+                "  machine limit: {t2} independent 1-thread renders of {} at once run {:.2}x one alone ({:.2} against {:.2} M samples/s); its {t2} threads: {speed_up:.2}x",
+                mis.label(),
+                c.speed_up(),
+                c.together_per_s / 1e6,
+                c.alone_per_s / 1e6,
+            );
+            rows.push(Row {
+                section: "machine_scaling",
+                scene: name.clone(),
+                strategy: mis.label(),
+                threads: t2,
+                n: 1,
+                value: c.speed_up(),
+                unit: "speed-up",
+            });
         }
         // The ray-tracing limit for the same ray mix, on one thread, against the 1-thread
         // render time of power MIS (which traces that mix). Whole groups of LANES samples per
