@@ -81,6 +81,36 @@ pub(crate) fn lobe_grid(wi: Vec3, a: (f32, f32)) -> LobeGrid {
     LobeGrid::around_reflection(wi, 2.0 * amin, (wi.z as f64).max(amin).min(1.0))
 }
 
+/// The half vector depends on the directions of wi and wo only, not on their lengths, which
+/// f32 `normalize` leaves off by up to ~2e-7: at grazing incidence wi + wo is only ~2 cos_i
+/// long, so the lengths tilted it by ~1e-5 rad (a 1e-3-rough lobe is 4e-3 rad wide).
+#[test]
+fn half_vector_ignores_input_lengths() {
+    let mut worst = 0.0f64;
+    for (c, phi) in [(0.01f64, 2.0f64), (0.02, 0.3), (0.5, 4.0)] {
+        let s = (1.0 - c * c).sqrt();
+        let wi = glam::DVec3::new(s * phi.cos(), s * phi.sin(), c);
+        for k in 0..16 {
+            let a = k as f64 * std::f64::consts::PI / 8.0;
+            let m = glam::DVec3::new(-3e-3 * a.cos(), -3e-3 * a.sin(), 1.0).normalize();
+            let wo = 2.0 * wi.dot(m) * m - wi;
+            for (li, lo) in [
+                (1.0 + 2e-7, 1.0 - 2e-7),
+                (1.0 - 2e-7, 1.0 + 2e-7),
+                (1.0, 1.0),
+            ] {
+                let (wi32, wo32) = ((wi * li).as_vec3(), (wo * lo).as_vec3());
+                // The half vector of exactly the directions the f32 inputs point in.
+                let exact = (wi32.as_dvec3().normalize() + wo32.as_dvec3().normalize()).normalize();
+                let h = RoughConductor::half(wi32, wo32).as_dvec3();
+                worst = worst.max(h.angle_between(exact));
+            }
+        }
+    }
+    // What is left is the f32 rounding of the result, ~6e-8 rad.
+    assert!(worst < 2e-7, "half vector {worst:.3e} rad off");
+}
+
 #[test]
 fn sample_eval_pdf_agree() {
     let mut worst = 0.0f32;
