@@ -3,8 +3,8 @@
 //! one-core clock, a neighbour's load, a shared cache), and no renderer's threads scale past
 //! what independent copies of it reach at once: the thread speed-up is read against this.
 
+use super::throughput;
 use crate::integrator::Strategy;
-use crate::render::{render, RenderSettings};
 use crate::scene::Scene;
 use std::time::Instant;
 
@@ -26,21 +26,14 @@ impl Copies {
 /// turns within each repetition (as `bench::throughputs`), so a slow spell of the machine
 /// hits both alike.
 pub fn measure(scene: &Scene, strategy: Strategy, spp: u32, copies: usize, repeat: u32) -> Copies {
-    let settings = RenderSettings {
-        spp,
-        seed: 1,
-        threads: Some(1),
-        progress: false,
-    };
     let samples = scene.camera.width as f64 * scene.camera.height as f64 * spp as f64;
     let (mut alone_per_s, mut together_per_s) = (0.0f64, 0.0f64);
     for _ in 0..repeat.max(1) {
-        let out = render(scene, strategy, &settings);
-        alone_per_s = alone_per_s.max(samples / out.seconds);
+        alone_per_s = alone_per_s.max(throughput(scene, strategy, spp, 1, 1));
         let start = Instant::now();
         std::thread::scope(|s| {
             for _ in 0..copies {
-                s.spawn(|| render(scene, strategy, &settings));
+                s.spawn(|| throughput(scene, strategy, spp, 1, 1));
             }
         });
         let seconds = start.elapsed().as_secs_f64().max(1e-9);

@@ -332,8 +332,8 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                 }
             }
         }
+        let mis = bench_strategies()[0];
         if let Some((t2, speed_up)) = first_speed_up {
-            let mis = bench_strategies()[0];
             let c = copies::measure(&scene, mis, a.spp, t2, a.repeat);
             println!(
                 "  machine limit: {t2} independent 1-thread renders of {} at once run {:.2}x one alone ({:.2} against {:.2} M samples/s); its {t2} threads: {speed_up:.2}x",
@@ -358,7 +358,6 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         let mix_spp = (a.spp / 16)
             .max(1)
             .next_multiple_of(crate::rng::LANES as u32);
-        let mis = bench_strategies()[0];
         let mix = raylimit::ray_mix(&scene, mix_spp, mis.selection);
         let limit = raylimit::measure(&scene, &mix, a.repeat, || {
             throughput(&scene, mis, a.spp, 1, 1)
