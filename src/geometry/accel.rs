@@ -3,6 +3,7 @@
 
 use super::bvh::WideBvh;
 use super::shape::{intersect_sphere, Shape, ShapeKind};
+use super::sphere8::Spheres8;
 use super::watertight::{Tri4, WatertightRay};
 use super::{Hit, Ray, SurfacePoint, NO_SKIP};
 use glam::{BVec4A, Vec2, Vec3, Vec3A};
@@ -60,6 +61,8 @@ pub struct Accel {
     tri_base: Vec<u32>,
     /// Primitives in the BVH (zero-area triangles have an id but are left out).
     n_prims: usize,
+    /// All the primitives as lanes, for `occluded`, when they are at most eight spheres.
+    spheres8: Option<Spheres8>,
 }
 
 /// A primitive before it is placed in a leaf.
@@ -116,6 +119,7 @@ impl Accel {
             refs,
             tri_base,
             n_prims: prims.len(),
+            spheres8: None,
         };
         if prims.is_empty() {
             return accel;
@@ -162,6 +166,9 @@ impl Accel {
                 n_tris,
                 spheres: (s0, accel.spheres.len() as u32),
             });
+        }
+        if accel.leaves.iter().all(|l| l.n_tris == 0) {
+            accel.spheres8 = Spheres8::new(accel.spheres.iter().map(|&(c, r, _)| (c, r)));
         }
         accel
     }
@@ -245,7 +252,18 @@ impl Accel {
     }
 
     /// True if anything blocks the ray within its interval.
+    #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
+        match &self.spheres8 {
+            Some(s) => s.any(ray.o, ray.d, ray.tmin, ray.tmax),
+            None => self.occluded_bvh(ray),
+        }
+    }
+
+    /// `occluded` by a walk of the BVH: out of line, so that the few-spheres test inlines
+    /// without the walk's stack frame.
+    #[inline(never)]
+    fn occluded_bvh(&self, ray: &Ray) -> bool {
         let (o, d, tmin, tmax) = (ray.o, ray.d, ray.tmin, ray.tmax);
         // Set up on the first leaf: many occlusion rays (and most emitter pre-tests) reach none.
         let mut wr = None;

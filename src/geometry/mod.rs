@@ -6,6 +6,7 @@ mod lanes8;
 pub mod packet;
 mod refine;
 pub mod shape;
+mod sphere8;
 pub mod watertight;
 mod watertight8;
 
