@@ -125,7 +125,7 @@ pub(super) struct CameraHits {
     skip: [u32; LANES],
     emitter_skip: [u32; LANES],
     /// The estimate so far (emission seen at the hit); None for lanes not shaded here.
-    l: [Option<Rgb>; LANES],
+    pub(super) l: [Option<Rgb>; LANES],
 }
 
 /// The sphere of each lane whose light is a sphere. Kept out of `LightDraws`: with these

@@ -122,7 +122,9 @@ impl Direct<'_> {
             }
         }
         for i in 0..LANES {
-            if !vis.done[i] {
+            // Lanes without a covered hit hold garbage (NaN), which would bisect to the
+            // 64-step limit: their samples are dropped, so they take no more steps.
+            if !vis.done[i] && h.l[i].is_some() {
                 let mut b = vis.get(i);
                 b.slope.finish();
                 vis.set(i, b);
@@ -191,5 +193,55 @@ impl VisibleX8 {
                 done: self.done[i],
             },
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::bsdf::BsdfKind;
+    use crate::geometry::Ray;
+    use crate::integrator::{Direct, Strategy};
+    use crate::rng::{Rng, RngLanes, LANES};
+    use crate::sampling::microfacet::ITERS;
+    use crate::scene::desc::StrategyKind;
+    use crate::scene::Scene;
+    use glam::Vec3;
+
+    /// Cost guard: in a batch of rough-conductor hits, lanes without a covered hit (rays
+    /// that leave the scene) take no Newton steps past the fixed ones. Their inversions are
+    /// garbage (NaN), which used to bisect to the 64-step limit: 61 steps per empty lane.
+    #[test]
+    fn empty_lanes_of_a_rough_batch_take_no_further_steps() {
+        let scene = Scene::build(crate::scene::bundled_tests::load("veach-mis/veach-mis.xml"))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mis = Strategy::combinations()
+            .into_iter()
+            .find(|s| s.kind == StrategyKind::Mis && s.emitter_samples == 1)
+            .unwrap();
+        let direct = Direct::new(&scene, mis);
+        assert!(direct.has_lanes());
+        let cam = &scene.camera;
+        let mut rng = Rng::new(2, 7);
+        // A camera ray onto a plate, down the middle column of the image.
+        let plate = (0..cam.height)
+            .map(|y| cam.generate_ray(cam.width / 2, y, &mut rng))
+            .find(|r| {
+                scene.intersect(r).is_some_and(|h| {
+                    matches!(scene.material(&h.sp).kind, BsdfKind::RoughConductor(_))
+                })
+            })
+            .expect("a ray onto a plate");
+        let away = Ray::new(plate.o, Vec3::Y);
+        assert!(scene.intersect(&away).is_none());
+        let rays: [Ray; LANES] = std::array::from_fn(|i| if i < 4 { plate } else { away });
+        let batches = 64;
+        ITERS.with(|c| c.set(0));
+        for b in 0..batches {
+            let mut lanes = RngLanes::for_pixel_samples(9, 8 * b);
+            direct.li_lanes(&rays, LANES, &mut lanes);
+        }
+        let per_batch = ITERS.with(|c| c.get()) as f64 / batches as f64;
+        // The four plate lanes need a fourth step about 4 % of the time.
+        assert!(per_batch < 1.0, "{per_batch} further steps per batch");
     }
 }
