@@ -169,30 +169,38 @@ impl Sphere {
 /// accurate when the sphere is small and far away.
 #[inline(always)]
 pub fn intersect_sphere(o: Vec3, d: Vec3, tmin: f32, tmax: f32, c: Vec3, r: f32) -> Option<f32> {
-    let f = o - c;
-    let a = d.dot(d);
-    let b = f.dot(d);
-    let cc = f.dot(f) - r * r;
-    let l = f - (b / a) * d;
-    let disc = a * (r * r - l.dot(l));
-    if disc < 0.0 {
-        return None;
-    }
-    let q = -(b + disc.sqrt().copysign(b));
-    if q == 0.0 {
-        return None;
-    }
-    let (mut t0, mut t1) = (cc / q, q / a);
-    if t0 > t1 {
-        std::mem::swap(&mut t0, &mut t1);
-    }
-    if t0 > tmin && t0 < tmax {
+    let (disc, q, t0, t1) = sphere_roots(o, d, c, r);
+    if disc < 0.0 || q == 0.0 {
+        None
+    } else if t0 > tmin && t0 < tmax {
         Some(t0)
     } else if t1 > tmin && t1 < tmax {
         Some(t1)
     } else {
         None
     }
+}
+
+/// `intersect_sphere`'s arithmetic: the discriminant, q and the two roots in order, which are
+/// roots only where the discriminant is >= 0 and q is not 0. Without branches, so that
+/// `sphere8` runs it in vector lanes with the same answers.
+#[inline(always)]
+pub(super) fn sphere_roots(o: Vec3, d: Vec3, c: Vec3, r: f32) -> (f32, f32, f32, f32) {
+    let f = o - c;
+    let a = d.dot(d);
+    let b = f.dot(d);
+    let cc = f.dot(f) - r * r;
+    let l = f - (b / a) * d;
+    let disc = a * (r * r - l.dot(l));
+    let q = -(b + disc.sqrt().copysign(b));
+    let (t0, t1) = (cc / q, q / a);
+    let swap = t0 > t1;
+    (
+        disc,
+        q,
+        if swap { t1 } else { t0 },
+        if swap { t0 } else { t1 },
+    )
 }
 
 /// Whether every triangle's vertex normals are its face normal (to 1e-5 per component, f32

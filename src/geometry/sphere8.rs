@@ -6,6 +6,7 @@
 //! Each lane computes bitwise what `intersect_sphere` computes, so a ray that query hits is
 //! a hit here: the pre-test never drops a hit of the closest-hit query after it.
 
+use super::shape::sphere_roots;
 use glam::Vec3;
 
 /// Most spheres the lanes hold.
@@ -72,20 +73,10 @@ fn may_hit_sphere(o: Vec3, d: Vec3, c: Vec3, r: f32) -> bool {
     x.dot(x) <= d.dot(d) * (2.0 * (r * r) + 2.0 * K2 * f.dot(f))
 }
 
-/// `intersect_sphere(..).is_some()`, the same operations in the same order, with selects for
-/// its early returns so that the loop over the lanes runs in vector lanes.
+/// `intersect_sphere(..).is_some()` with selects for its branches.
 #[inline(always)]
 fn hits_sphere(o: Vec3, d: Vec3, tmin: f32, tmax: f32, c: Vec3, r: f32) -> bool {
-    let f = o - c;
-    let a = d.dot(d);
-    let b = f.dot(d);
-    let cc = f.dot(f) - r * r;
-    let l = f - (b / a) * d;
-    let disc = a * (r * r - l.dot(l));
-    let q = -(b + disc.sqrt().copysign(b));
-    let (t0, t1) = (cc / q, q / a);
-    let swap = t0 > t1;
-    let (t0, t1) = (if swap { t1 } else { t0 }, if swap { t0 } else { t1 });
+    let (disc, q, t0, t1) = sphere_roots(o, d, c, r);
     let inside = |t: f32| t > tmin && t < tmax;
     !(disc < 0.0) & (q != 0.0) & (inside(t0) | inside(t1))
 }
