@@ -14,14 +14,17 @@ hangs), so there is no 1-thread row.
 
 With --directlab, each Mitsuba render is followed by a directlab render of the same scene, spp,
 size and thread count with the same estimator (`mis-power-e1b1-uni-area`, its render time from
---stats), and both best-of-N numbers are reported: on a shared VM whose speed drifts by tens of
-percent over minutes, only renders interleaved like this compare the two renderers fairly.
+--stats), and both best-of-N numbers are reported, with the median over the N pairs of the
+ratio of a directlab render to the Mitsuba render before it (`ratio_paired_median`): on a
+shared VM whose speed drifts by tens of percent over minutes, only renders interleaved like
+this compare the two renderers fairly.
 """
 
 import argparse
 import csv
 import os
 import platform
+import statistics
 import json
 import subprocess
 import sys
@@ -125,6 +128,19 @@ def main():
                 rows.append(("throughput", path, label, a.threads, 0, max(ours), "samples/s"))
                 rows.append(
                     ("throughput_slowest", path, label, a.threads, 0, min(ours), "samples/s")
+                )
+                # Each directlab render against the Mitsuba render just before it: a drift of
+                # the VM's speed over minutes moves both of a pair, so the median of the pairs'
+                # ratios is steadier than the ratio of the two bests.
+                ratios = [o / (n / t) for o, t in zip(ours, times)]
+                med = statistics.median(ratios)
+                faster = sum(r > 1 for r in ratios)
+                print(
+                    f"  {'':<12} {'':<32} paired renders: median ratio {med:.2f}x, "
+                    f"directlab faster in {faster} of {len(ratios)}"
+                )
+                rows.append(
+                    ("ratio_paired_median", path, label, a.threads, len(ratios), med, "ratio")
                 )
     os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=os.path.dirname(a.out) or ".", suffix=".tmp")
