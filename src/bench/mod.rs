@@ -113,7 +113,7 @@ fn throughput(
     threads: usize,
     repeat: u32,
 ) -> f64 {
-    throughputs(scene, strategy, spp, &[threads], repeat)[0].samples_per_s
+    throughputs(scene, &[strategy], spp, &[threads], repeat)[0][0].samples_per_s
 }
 
 /// The fastest of a thread count's timed renders.
@@ -129,46 +129,56 @@ struct Timed {
     slowest_samples_per_s: f64,
 }
 
-/// Samples per second at each thread count, best of `repeat`. The thread counts take turns
-/// within each repetition, so a slow spell of a shared machine (minutes long on this VM) hits
-/// all of them alike instead of the one measured during it: their ratio is the scaling.
+/// Samples per second of each strategy at each thread count, best of `repeat`. Every
+/// (strategy, thread count) pair takes its turn within each repetition, so a slow spell of a
+/// shared machine (minutes long on this VM) hits all of them alike instead of the ones
+/// measured during it: the ratio of two thread counts is the scaling, and two strategies
+/// compare. Timed one strategy after another, two strategies doing the same work (uniform
+/// and power emitter choice with one emitter) once read 1.43x apart.
 fn throughputs(
     scene: &crate::scene::Scene,
-    strategy: Strategy,
+    strategies: &[Strategy],
     spp: u32,
     threads: &[usize],
     repeat: u32,
-) -> Vec<Timed> {
+) -> Vec<Vec<Timed>> {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let samples = w as f64 * h as f64 * spp as f64;
-    let mut best: Vec<Option<Timed>> = vec![None; threads.len()];
-    let mut slowest = vec![f64::INFINITY; threads.len()];
+    let mut best: Vec<Vec<Option<Timed>>> = vec![vec![None; threads.len()]; strategies.len()];
+    let mut slowest = vec![vec![f64::INFINITY; threads.len()]; strategies.len()];
     for _ in 0..repeat.max(1) {
-        for ((b, slow), &t) in best.iter_mut().zip(&mut slowest).zip(threads) {
-            let settings = RenderSettings {
-                spp,
-                seed: 1,
-                threads: Some(t),
-                progress: false,
-            };
-            let out = render(scene, strategy, &settings);
-            let samples_per_s = samples / out.seconds;
-            *slow = slow.min(samples_per_s);
-            if b.is_none_or(|b| samples_per_s > b.samples_per_s) {
-                *b = Some(Timed {
-                    samples_per_s,
-                    busy: out.busy_seconds / (out.seconds * t as f64),
-                    work_per_sample: out.busy_seconds / samples,
-                    slowest_samples_per_s: samples_per_s,
-                });
+        for ((&strategy, best), slowest) in strategies.iter().zip(&mut best).zip(&mut slowest) {
+            for ((b, slow), &t) in best.iter_mut().zip(slowest.iter_mut()).zip(threads) {
+                let settings = RenderSettings {
+                    spp,
+                    seed: 1,
+                    threads: Some(t),
+                    progress: false,
+                };
+                let out = render(scene, strategy, &settings);
+                let samples_per_s = samples / out.seconds;
+                *slow = slow.min(samples_per_s);
+                if b.is_none_or(|b| samples_per_s > b.samples_per_s) {
+                    *b = Some(Timed {
+                        samples_per_s,
+                        busy: out.busy_seconds / (out.seconds * t as f64),
+                        work_per_sample: out.busy_seconds / samples,
+                        slowest_samples_per_s: samples_per_s,
+                    });
+                }
             }
         }
     }
     best.into_iter()
         .zip(slowest)
-        .map(|(b, slowest_samples_per_s)| Timed {
-            slowest_samples_per_s,
-            ..b.expect("at least one repetition")
+        .map(|(best, slowest)| {
+            best.into_iter()
+                .zip(slowest)
+                .map(|(b, slowest_samples_per_s)| Timed {
+                    slowest_samples_per_s,
+                    ..b.expect("at least one repetition")
+                })
+                .collect()
         })
         .collect()
 }
@@ -268,8 +278,9 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         println!("  {name}: {}x{}", scene.camera.width, scene.camera.height);
         // The first strategy's thread speed-up, read against the machine's own below.
         let mut first_speed_up = None;
-        for strategy in bench_strategies() {
-            let all = throughputs(&scene, strategy, a.spp, &a.threads, a.repeat);
+        let strategies = bench_strategies();
+        let timed = throughputs(&scene, &strategies, a.spp, &a.threads, a.repeat);
+        for (&strategy, all) in strategies.iter().zip(timed) {
             let by_threads: Vec<(usize, Timed)> = a.threads.iter().copied().zip(all).collect();
             for &(threads, timed) in &by_threads {
                 println!(
@@ -371,11 +382,12 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             1.0 / limit.by_type.seconds_per_sample / 1e6,
         );
         println!(
-            "  {} at {:.2} M samples/s: {:.0}% of render time outside traversal ({:.0}% against the traversal by type)",
+            "  {} at {:.2} M samples/s: {:.0}% of render time outside traversal ({:.0}% against the traversal by type), {:.1} ns per sample",
             mis.label(),
             limit.render_per_s / 1e6,
             limit.share_outside * 100.0,
             limit.share_outside_by_type * 100.0,
+            limit.outside_seconds_per_sample * 1e9,
         );
         let raw = raylimit::measure_obvhs(&scene, &mix, a.repeat);
         println!(
@@ -403,6 +415,11 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                 "share_outside_traversal_by_type",
                 limit.share_outside_by_type,
                 "fraction",
+            ),
+            (
+                "outside_traversal_per_sample",
+                limit.outside_seconds_per_sample * 1e9,
+                "ns",
             ),
             ("obvhs_closest_hit_rays", raw.closest_per_s, "rays/s"),
             ("obvhs_occlusion_rays", raw.occlusion_per_s, "rays/s"),

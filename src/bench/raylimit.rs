@@ -155,6 +155,10 @@ pub struct Limit {
     /// ratio instead of one.
     pub share_outside: f64,
     pub share_outside_by_type: f64,
+    /// Render seconds per sample outside traversal (render order), median over the
+    /// repetitions: the share's numerator in absolute terms, which a faster traversal does
+    /// not move (it raises the share) and which compares across renderers.
+    pub outside_seconds_per_sample: f64,
 }
 
 fn median(x: Vec<f64>) -> f64 {
@@ -169,7 +173,7 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
     // asks them, shadow rays, and the whole mix in the renderer's order.
     let mut best = [f64::INFINITY; 5];
     let mut best_render = 0.0f64;
-    let (mut shares, mut shares_by_type) = (Vec::new(), Vec::new());
+    let (mut shares, mut shares_by_type, mut outside) = (Vec::new(), Vec::new(), Vec::new());
     let mut sink = 0usize;
     let prim = |h: Option<Hit>| h.map_or(0, |h| h.sp.prim as usize & 1);
     let packet_prims = |h: [Option<Hit>; LANES]| h.into_iter().map(prim).sum::<usize>();
@@ -207,6 +211,7 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
         let in_order = t.elapsed().as_secs_f64();
         let render_per_s = render();
         shares.push(1.0 - in_order / n * render_per_s);
+        outside.push(1.0 / render_per_s - in_order / n);
         shares_by_type.push(1.0 - (camera + bsdf_query + occl) / n * render_per_s);
         best_render = best_render.max(render_per_s);
         for (b, x) in best
@@ -229,6 +234,7 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
         render_per_s: best_render,
         share_outside: median(shares),
         share_outside_by_type: median(shares_by_type),
+        outside_seconds_per_sample: median(outside),
     }
 }
 
