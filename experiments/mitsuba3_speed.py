@@ -8,7 +8,9 @@ power-heuristic MIS: the bench's mis-power-e1b1 rows), render time only.
                                           [--directlab target/release/directlab]
 
 Prints one line per variant and scene and writes reports/bench/mitsuba3.csv (same columns as
-bench.csv). Each number is the best of --repeat renders; the JIT variant's first, compiling
+bench.csv). For the JIT variant it also measures Mitsuba's own share of render time outside
+traversal, as `directlab bench` measures directlab's (`traversal_share`; --traversal-spp 0
+skips it), and that time per sample in absolute terms. Each number is the best of --repeat renders; the JIT variant's first, compiling
 render is timed apart and not counted. Mitsuba needs 2 or more threads (with 1, writing an EXR
 hangs), so there is no 1-thread row.
 
@@ -60,6 +62,56 @@ def directlab_speed(a, path, sized):
             return json.load(f)["samples_per_second"]
 
 
+def traversal_share(dr, mi, scene, spp, repeat):
+    """Mitsuba's own share of render time outside traversal, measured as `directlab bench`
+    measures directlab's: the ray mix of its `direct` integrator (a camera ray, a shadow ray
+    to the emitter sample where its density is non-zero, a BSDF ray where the BSDF sample is
+    valid) is drawn first, then each ray type is traced alone, best of `repeat` after a
+    compiling call. Returns seconds per camera sample for (camera, shadow, BSDF) rays with
+    the closest-hit query that builds the surface interaction (`ray_intersect`, as directlab's
+    traversal builds its surface point) and with the bare query (`ray_intersect_preliminary`).
+    """
+    sensor = scene.sensors()[0]
+    w, h = sensor.film().size()
+    n = w * h * spp
+    sampler = mi.load_dict({"type": "independent"})
+    sampler.seed(1, n)
+    pixel = dr.arange(mi.UInt32, n) // spp
+    pos = mi.Vector2f(mi.Float(pixel % w), mi.Float(pixel // w)) + sampler.next_2d()
+    ray, _ = sensor.sample_ray(0.0, 0.5, pos / mi.Vector2f(w, h), mi.Point2f(0.5))
+    si = scene.ray_intersect(ray)
+    valid = si.is_valid()
+    ds, _ = scene.sample_emitter_direction(si, sampler.next_2d(), False, valid)
+    shadow = si.spawn_ray_to(ds.p)
+    shadow_on = valid & (ds.pdf > 0)
+    bs, _ = si.bsdf(ray).sample(mi.BSDFContext(), si, sampler.next_1d(), sampler.next_2d(), valid)
+    bray = si.spawn_ray(si.to_world(bs.wo))
+    bsdf_on = valid & (bs.pdf > 0)
+    dr.eval(ray, shadow, shadow_on, bray, bsdf_on)
+    dr.sync_thread()
+
+    def best(f):
+        times = []
+        for _ in range(repeat + 1):  # the first call compiles
+            t = time.perf_counter()
+            dr.eval(f())
+            dr.sync_thread()
+            times.append(time.perf_counter() - t)
+        return min(times[1:]) / n
+
+    full = (
+        best(lambda: scene.ray_intersect(ray).t),
+        best(lambda: scene.ray_test(shadow, active=shadow_on)),
+        best(lambda: scene.ray_intersect(bray, active=bsdf_on).t),
+    )
+    bare = (
+        best(lambda: scene.ray_intersect_preliminary(ray).t),
+        full[1],
+        best(lambda: scene.ray_intersect_preliminary(bray, active=bsdf_on).t),
+    )
+    return full, bare
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--threads", type=int, default=2)
@@ -69,6 +121,9 @@ def main():
     ap.add_argument("--variants", default="scalar_rgb,llvm_ad_rgb")
     ap.add_argument("--out", default="reports/bench/mitsuba3.csv")
     ap.add_argument("--directlab", help="directlab binary to interleave with Mitsuba's renders")
+    ap.add_argument("--traversal-spp", type=int, default=16,
+                    help="samples per pixel of the JIT variant's traversal-share measurement "
+                    "(0 skips it)")
     a = ap.parse_args()
     if a.threads < 2:
         sys.exit("mitsuba3_speed.py: --threads must be 2 or more (Mitsuba hangs with 1)")
@@ -118,6 +173,27 @@ def main():
             label = f"mitsuba3-{variant}-direct-e1b1"
             rows.append(("throughput", path, label, a.threads, 0, sps, "samples/s"))
             rows.append(("throughput_slowest", path, label, a.threads, 0, slowest, "samples/s"))
+            if variant.startswith("llvm") and a.traversal_spp > 0:
+                full, bare = traversal_share(dr, mi, scene, a.traversal_spp, a.repeat)
+                for name, parts in (("", full), ("_bare", bare)):
+                    share = 1.0 - sum(parts) * sps
+                    # Thread time, as directlab bench's 1-thread ns per sample.
+                    ns = (1.0 / sps - sum(parts)) * a.threads * 1e9
+                    print(
+                        f"  {'':<12} {'':<32} {share * 100:.0f}% of its render time outside "
+                        f"traversal{' (bare closest-hit queries)' if name else ''}, "
+                        f"{ns:.0f} ns of thread time per sample: camera "
+                        f"{1e-6 / parts[0]:.1f} M rays/s, shadow {1e-6 / parts[1]:.1f} M, "
+                        f"BSDF {1e-6 / parts[2]:.1f} M (per camera sample)"
+                    )
+                    rows.append(
+                        (f"share_outside_traversal{name}", path, label, a.threads, 0, share,
+                         "fraction")
+                    )
+                    rows.append(
+                        (f"outside_traversal_per_sample{name}", path, label, a.threads, 0, ns,
+                         "ns thread time")
+                    )
             if ours:
                 print(
                     f"  {'directlab':<12} {path:<32} {max(ours) / 1e6:7.2f} M samples/s, "
