@@ -144,25 +144,40 @@ fn throughputs(
 ) -> Vec<Vec<Timed>> {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let samples = w as f64 * h as f64 * spp as f64;
+    best_of_turns(strategies, threads, repeat, samples, |strategy, t| {
+        let settings = RenderSettings {
+            spp,
+            seed: 1,
+            threads: Some(t),
+            progress: false,
+        };
+        let out = render(scene, strategy, &settings);
+        (out.seconds, out.busy_seconds)
+    })
+}
+
+/// `throughputs`' schedule and bookkeeping around `time`, which renders `samples` camera
+/// samples with a strategy and thread count and returns (seconds, busy worker seconds).
+fn best_of_turns(
+    strategies: &[Strategy],
+    threads: &[usize],
+    repeat: u32,
+    samples: f64,
+    mut time: impl FnMut(Strategy, usize) -> (f64, f64),
+) -> Vec<Vec<Timed>> {
     let mut best: Vec<Vec<Option<Timed>>> = vec![vec![None; threads.len()]; strategies.len()];
     let mut slowest = vec![vec![f64::INFINITY; threads.len()]; strategies.len()];
     for _ in 0..repeat.max(1) {
         for ((&strategy, best), slowest) in strategies.iter().zip(&mut best).zip(&mut slowest) {
             for ((b, slow), &t) in best.iter_mut().zip(slowest.iter_mut()).zip(threads) {
-                let settings = RenderSettings {
-                    spp,
-                    seed: 1,
-                    threads: Some(t),
-                    progress: false,
-                };
-                let out = render(scene, strategy, &settings);
-                let samples_per_s = samples / out.seconds;
+                let (seconds, busy_seconds) = time(strategy, t);
+                let samples_per_s = samples / seconds;
                 *slow = slow.min(samples_per_s);
                 if b.is_none_or(|b| samples_per_s > b.samples_per_s) {
                     *b = Some(Timed {
                         samples_per_s,
-                        busy: out.busy_seconds / (out.seconds * t as f64),
-                        work_per_sample: out.busy_seconds / samples,
+                        busy: busy_seconds / (seconds * t as f64),
+                        work_per_sample: busy_seconds / samples,
                         slowest_samples_per_s: samples_per_s,
                     });
                 }
@@ -534,4 +549,56 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
     })?;
     eprintln!("wrote {}", a.out.display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every (strategy, thread count) renders once per repetition, in turn, and keeps its
+    /// fastest and slowest: a slow spell (here the whole first repetition, at half speed)
+    /// moves every pair's slowest and no pair's best. Timed one strategy after another, the
+    /// spell would have fallen on the first strategy alone.
+    #[test]
+    fn strategies_and_thread_counts_take_turns() {
+        let strategies = &bench_strategies()[..3];
+        let threads = [1, 2];
+        let mut calls = Vec::new();
+        let timed = best_of_turns(strategies, &threads, 4, 1e6, |s, t| {
+            let spell = if calls.len() < strategies.len() * threads.len() {
+                2.0
+            } else {
+                1.0
+            };
+            calls.push((s.label(), t));
+            // Each pair its own speed: 1 s per 1e6 samples for the first strategy at one
+            // thread, faster for later strategies and more threads.
+            let k = strategies
+                .iter()
+                .position(|x| x.label() == s.label())
+                .unwrap();
+            let seconds = spell / ((k + 1) as f64 * t as f64);
+            (seconds, seconds * t as f64 * 0.5)
+        });
+        let turn: Vec<_> = strategies
+            .iter()
+            .flat_map(|s| threads.map(|t| (s.label(), t)))
+            .collect();
+        let turns: Vec<_> = (0..4).flat_map(|_| turn.iter().cloned()).collect();
+        assert_eq!(calls, turns);
+        for (k, row) in timed.iter().enumerate() {
+            for (j, timed) in row.iter().enumerate() {
+                let want = 1e6 * (k + 1) as f64 * threads[j] as f64;
+                let close = |x: f64, y: f64| (x - y).abs() <= 1e-9 * y;
+                assert!(
+                    close(timed.samples_per_s, want),
+                    "{k} {j}: {}",
+                    timed.samples_per_s
+                );
+                let slowest = timed.slowest_samples_per_s;
+                assert!(close(slowest, want / 2.0), "{k} {j}: {slowest}");
+                assert!(close(timed.busy, 0.5), "{k} {j}: {}", timed.busy);
+            }
+        }
+    }
 }
