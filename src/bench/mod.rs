@@ -1,9 +1,9 @@
 //! `directlab bench`: speed goals as measured numbers (printed and written to
 //! `reports/bench/bench.csv`), never timed tests. Sections: render throughput per scene,
 //! strategy and thread count; the machine's own scaling (independent 1-thread renders side by
-//! side); the ray-tracing limit for the same ray mix and the share of
-//! render time spent outside traversal; per-sample cost as the triangle and emitter counts
-//! grow; peak memory.
+//! side); the ray-tracing limit for the same ray mix and the share of render time spent
+//! outside traversal (and that time per sample), on one thread and on the most threads;
+//! per-sample cost as the triangle and emitter counts grow; peak memory.
 
 mod copies;
 mod raylimit;
@@ -404,6 +404,19 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             limit.share_outside_by_type * 100.0,
             limit.outside_seconds_per_sample * 1e9,
         );
+        // The same on the most threads, as Mitsuba's script measures Mitsuba (no fewer
+        // than two threads), in thread time per sample.
+        let parallel = (max_threads > 1).then(|| {
+            let t = max_threads;
+            let render = || throughput(&scene, mis, a.spp, t, 1);
+            let (share, outside) = raylimit::measure_threads(&scene, &mix, t, a.repeat, render);
+            println!(
+                "  at {max_threads} threads: {:.0}% of render time outside traversal, {:.1} ns of thread time per sample",
+                share * 100.0,
+                outside * 1e9,
+            );
+            (share, outside)
+        });
         let raw = raylimit::measure_obvhs(&scene, &mix, a.repeat);
         println!(
             "  raw obvhs (its CwBvh traversal and triangle test, same rays): {:.2} M closest-hit rays/s, {:.2} M occlusion rays/s",
@@ -448,6 +461,26 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                 value: v,
                 unit,
             });
+        }
+        if let Some((share, outside)) = parallel {
+            for (what, v, unit) in [
+                ("share_outside_traversal", share, "fraction"),
+                (
+                    "outside_traversal_per_sample",
+                    outside * 1e9,
+                    "ns thread time",
+                ),
+            ] {
+                rows.push(Row {
+                    section: "ray_limit",
+                    scene: name.clone(),
+                    strategy: format!("{}:{what}", mis.label()),
+                    threads: max_threads,
+                    n: 0,
+                    value: v,
+                    unit,
+                });
+            }
         }
     }
     let mis = bench_strategies()[0];

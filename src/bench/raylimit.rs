@@ -200,14 +200,7 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
         }
         let occl = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        for p in &mix.packets {
-            sink += packet_prims(scene.intersect8(&p.camera.0, p.camera.1));
-            sink += scene.accel.occluded8(&p.shadow.0, p.shadow.1) as usize;
-            for &b in p.bsdf.iter().filter(|&&b| b != NONE) {
-                let (r, skip) = &mix.bsdf[b as usize];
-                sink += prim(scene.bsdf_ray_hit(r, *skip));
-            }
-        }
+        sink += trace_in_order(scene, mix, mix.packets.iter());
         let in_order = t.elapsed().as_secs_f64();
         let render_per_s = render();
         shares.push(1.0 - in_order / n * render_per_s);
@@ -236,6 +229,70 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
         share_outside_by_type: median(shares_by_type),
         outside_seconds_per_sample: median(outside),
     }
+}
+
+/// The groups in the renderer's order: each group's camera packet, its shadow packet, then
+/// its BSDF rays one by one, as the renderer's queries. Returns a checksum of the answers.
+fn trace_in_order<'a>(
+    scene: &Scene,
+    mix: &RayMix,
+    packets: impl Iterator<Item = &'a Packets>,
+) -> usize {
+    let prim = |h: Option<Hit>| h.map_or(0, |h| h.sp.prim as usize & 1);
+    let mut sink = 0;
+    for p in packets {
+        sink += scene
+            .intersect8(&p.camera.0, p.camera.1)
+            .into_iter()
+            .map(prim)
+            .sum::<usize>();
+        sink += scene.accel.occluded8(&p.shadow.0, p.shadow.1) as usize;
+        for &b in p.bsdf.iter().filter(|&&b| b != NONE) {
+            let (r, skip) = &mix.bsdf[b as usize];
+            sink += prim(scene.bsdf_ray_hit(r, *skip));
+        }
+    }
+    sink
+}
+
+/// The share outside traversal on `threads` threads, and that time per sample in thread time
+/// (seconds per sample times `threads`): the mix traced in the renderer's order by `threads`
+/// threads at once, each taking every `threads`-th run of 256 groups, against `render` (one
+/// render on `threads` threads, returning its samples per second), alternately, `repeat`
+/// times; medians. Mitsuba renders on no fewer than two threads: this is the number its
+/// script's share compares with.
+pub fn measure_threads(
+    scene: &Scene,
+    mix: &RayMix,
+    threads: usize,
+    repeat: u32,
+    mut render: impl FnMut() -> f64,
+) -> (f64, f64) {
+    let n = mix.n_camera as f64;
+    let (mut shares, mut outside) = (Vec::new(), Vec::new());
+    let mut sink = 0usize;
+    for _ in 0..repeat.max(1) {
+        let t = Instant::now();
+        sink += std::thread::scope(|s| {
+            let runs: Vec<_> = (0..threads)
+                .map(|k| {
+                    s.spawn(move || {
+                        let mine = mix.packets.chunks(256).skip(k).step_by(threads);
+                        trace_in_order(scene, mix, mine.flatten())
+                    })
+                })
+                .collect();
+            runs.into_iter()
+                .map(|r| r.join().expect("tracing thread"))
+                .sum::<usize>()
+        });
+        let traced = t.elapsed().as_secs_f64();
+        let render_per_s = render();
+        shares.push(1.0 - traced / n * render_per_s);
+        outside.push((1.0 / render_per_s - traced / n) * threads as f64);
+    }
+    std::hint::black_box(sink);
+    (median(shares), median(outside))
 }
 
 /// The same mix through obvhs's own CwBvh traversal and triangle test (spheres use
