@@ -175,8 +175,6 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
     let mut best_render = 0.0f64;
     let (mut shares, mut shares_by_type, mut outside) = (Vec::new(), Vec::new(), Vec::new());
     let mut sink = 0usize;
-    let prim = |h: Option<Hit>| h.map_or(0, |h| h.sp.prim as usize & 1);
-    let packet_prims = |h: [Option<Hit>; LANES]| h.into_iter().map(prim).sum::<usize>();
     let n = mix.n_camera as f64;
     for _ in 0..repeat.max(1) {
         let t = Instant::now();
@@ -231,6 +229,15 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
     }
 }
 
+/// A checksum bit of a hit, so that no query's answer goes unused.
+fn prim(h: Option<Hit>) -> usize {
+    h.map_or(0, |h| h.sp.prim as usize & 1)
+}
+
+fn packet_prims(h: [Option<Hit>; LANES]) -> usize {
+    h.into_iter().map(prim).sum()
+}
+
 /// The groups in the renderer's order: each group's camera packet, its shadow packet, then
 /// its BSDF rays one by one, as the renderer's queries. Returns a checksum of the answers.
 fn trace_in_order<'a>(
@@ -238,14 +245,9 @@ fn trace_in_order<'a>(
     mix: &RayMix,
     packets: impl Iterator<Item = &'a Packets>,
 ) -> usize {
-    let prim = |h: Option<Hit>| h.map_or(0, |h| h.sp.prim as usize & 1);
     let mut sink = 0;
     for p in packets {
-        sink += scene
-            .intersect8(&p.camera.0, p.camera.1)
-            .into_iter()
-            .map(prim)
-            .sum::<usize>();
+        sink += packet_prims(scene.intersect8(&p.camera.0, p.camera.1));
         sink += scene.accel.occluded8(&p.shadow.0, p.shadow.1) as usize;
         for &b in p.bsdf.iter().filter(|&&b| b != NONE) {
             let (r, skip) = &mix.bsdf[b as usize];
