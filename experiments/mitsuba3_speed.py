@@ -10,8 +10,8 @@ power-heuristic MIS: the bench's mis-power-e1b1 rows), render time only.
 Prints one line per variant and scene and writes reports/bench/mitsuba3.csv (same columns as
 bench.csv). For the JIT variant it also measures Mitsuba's own share of render time outside
 traversal, as `directlab bench` measures directlab's (`traversal_share`; --traversal-spp 0
-skips it), and that time per sample in absolute terms. Each number is the best of --repeat renders; the JIT variant's first, compiling
-render is timed apart and not counted. Mitsuba needs 2 or more threads (with 1, writing an EXR
+skips it), and that time per sample in absolute terms. Each number is the best of --repeat
+renders; the JIT variant's first, compiling render is timed apart and not counted. Mitsuba needs 2 or more threads (with 1, writing an EXR
 hangs), so there is no 1-thread row.
 
 With --directlab, each Mitsuba render is followed by a directlab render of the same scene, spp,
@@ -106,7 +106,7 @@ def traversal_share(dr, mi, scene, spp, repeat):
     )
     bare = (
         best(lambda: scene.ray_intersect_preliminary(ray).t),
-        full[1],
+        full[1],  # an occlusion query has no lighter form
         best(lambda: scene.ray_intersect_preliminary(bray, active=bsdf_on).t),
     )
     return full, bare

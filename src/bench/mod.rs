@@ -411,7 +411,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             let render = || throughput(&scene, mis, a.spp, t, 1);
             let (share, outside) = raylimit::measure_threads(&scene, &mix, t, a.repeat, render);
             println!(
-                "  at {max_threads} threads: {:.0}% of render time outside traversal, {:.1} ns of thread time per sample",
+                "  at {t} threads: {:.0}% of render time outside traversal, {:.1} ns of thread time per sample",
                 share * 100.0,
                 outside * 1e9,
             );
@@ -423,7 +423,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             raw.closest_per_s / 1e6,
             raw.occlusion_per_s / 1e6,
         );
-        for (what, v, unit) in [
+        let one_thread = [
             ("closest_hit_rays", limit.by_type.closest_per_s, "rays/s"),
             ("occlusion_rays", limit.by_type.occlusion_per_s, "rays/s"),
             ("bsdf_emitter_query_rays", limit.bsdf_query_per_s, "rays/s"),
@@ -451,36 +451,29 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             ),
             ("obvhs_closest_hit_rays", raw.closest_per_s, "rays/s"),
             ("obvhs_occlusion_rays", raw.occlusion_per_s, "rays/s"),
-        ] {
-            rows.push(Row {
-                section: "ray_limit",
-                scene: name.clone(),
-                strategy: format!("{}:{what}", mis.label()),
-                threads: 1,
-                n: 0,
-                value: v,
-                unit,
-            });
-        }
-        if let Some((share, outside)) = parallel {
-            for (what, v, unit) in [
+        ]
+        .map(|row| (1, row));
+        let most_threads = parallel.into_iter().flat_map(|(share, outside)| {
+            [
                 ("share_outside_traversal", share, "fraction"),
                 (
                     "outside_traversal_per_sample",
                     outside * 1e9,
                     "ns thread time",
                 ),
-            ] {
-                rows.push(Row {
-                    section: "ray_limit",
-                    scene: name.clone(),
-                    strategy: format!("{}:{what}", mis.label()),
-                    threads: max_threads,
-                    n: 0,
-                    value: v,
-                    unit,
-                });
-            }
+            ]
+            .map(|row| (max_threads, row))
+        });
+        for (threads, (what, v, unit)) in one_thread.into_iter().chain(most_threads) {
+            rows.push(Row {
+                section: "ray_limit",
+                scene: name.clone(),
+                strategy: format!("{}:{what}", mis.label()),
+                threads,
+                n: 0,
+                value: v,
+                unit,
+            });
         }
     }
     let mis = bench_strategies()[0];
