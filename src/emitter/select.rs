@@ -1,6 +1,7 @@
 //! Choosing which emitter to sample: uniformly, or in proportion to emitted power.
 
 use super::Emitter;
+use crate::sampling::discrete::bin_index;
 use crate::sampling::AliasTable;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -45,7 +46,7 @@ impl EmitterSelector {
                 (i, t.pmf(i))
             }
             None => {
-                let i = ((u * self.count as f32) as usize).min(self.count - 1);
+                let i = bin_index(u * self.count as f32, self.count);
                 (i, 1.0 / self.count as f32)
             }
         })
