@@ -110,6 +110,8 @@ fn bench_writes_every_section() {
     // outside traversal, and the share and that time again at 2 threads; obvhs: two rates.
     assert_eq!(sections["ray_limit"], 13, "{sections:?}");
     assert_eq!(sections["scaling_triangles"], 2, "{sections:?}");
+    // Growth over the sweep: best against best, and the median of paired ratios.
+    assert_eq!(sections["scaling_triangles_growth"], 2, "{sections:?}");
     // Two selectors (uniform, power) at 1 and 10 emitters.
     assert_eq!(sections["scaling_emitters"], 4, "{sections:?}");
     assert_eq!(sections["emitter_choice"], 4, "{sections:?}");
