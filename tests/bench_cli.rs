@@ -40,6 +40,7 @@ fn bench_writes_every_section() {
         "M samples/s",
         "1->2",
         "workers busy",
+        "paired median",
         "slowest run",
         "ray-tracing limit",
         "of render time outside traversal",
@@ -98,6 +99,10 @@ fn bench_writes_every_section() {
         "{sections:?}"
     );
     assert_eq!(sections["thread_scaling"], strategies, "{sections:?}");
+    assert_eq!(
+        sections["thread_scaling_paired"], strategies,
+        "{sections:?}"
+    );
     assert_eq!(sections["thread_busy"], strategies, "{sections:?}");
     // Two independent 1-thread renders against one, once per scene.
     assert_eq!(sections["machine_scaling"], 1, "{sections:?}");

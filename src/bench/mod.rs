@@ -117,7 +117,7 @@ fn throughput(
 }
 
 /// The fastest of a thread count's timed renders.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 struct Timed {
     samples_per_s: f64,
     /// Share of the workers' time spent in tiles (the rest is waiting).
@@ -127,6 +127,8 @@ struct Timed {
     /// Samples per second of the slowest repetition: how far this machine's interference
     /// moved the runs.
     slowest_samples_per_s: f64,
+    /// Samples per second of every repetition, in order.
+    runs: Vec<f64>,
 }
 
 /// Samples per second of each strategy at each thread count, best of `repeat`. Every
@@ -166,31 +168,33 @@ fn best_of_turns(
     mut time: impl FnMut(Strategy, usize) -> (f64, f64),
 ) -> Vec<Vec<Timed>> {
     let mut best: Vec<Vec<Option<Timed>>> = vec![vec![None; threads.len()]; strategies.len()];
-    let mut slowest = vec![vec![f64::INFINITY; threads.len()]; strategies.len()];
+    let mut runs = vec![vec![Vec::new(); threads.len()]; strategies.len()];
     for _ in 0..repeat.max(1) {
-        for ((&strategy, best), slowest) in strategies.iter().zip(&mut best).zip(&mut slowest) {
-            for ((b, slow), &t) in best.iter_mut().zip(slowest.iter_mut()).zip(threads) {
+        for ((&strategy, best), runs) in strategies.iter().zip(&mut best).zip(&mut runs) {
+            for ((b, runs), &t) in best.iter_mut().zip(runs.iter_mut()).zip(threads) {
                 let (seconds, busy_seconds) = time(strategy, t);
                 let samples_per_s = samples / seconds;
-                *slow = slow.min(samples_per_s);
-                if b.is_none_or(|b| samples_per_s > b.samples_per_s) {
+                runs.push(samples_per_s);
+                if b.as_ref().is_none_or(|b| samples_per_s > b.samples_per_s) {
                     *b = Some(Timed {
                         samples_per_s,
                         busy: busy_seconds / (seconds * t as f64),
                         work_per_sample: busy_seconds / samples,
                         slowest_samples_per_s: samples_per_s,
+                        runs: Vec::new(),
                     });
                 }
             }
         }
     }
     best.into_iter()
-        .zip(slowest)
-        .map(|(best, slowest)| {
+        .zip(runs)
+        .map(|(best, runs)| {
             best.into_iter()
-                .zip(slowest)
-                .map(|(b, slowest_samples_per_s)| Timed {
-                    slowest_samples_per_s,
+                .zip(runs)
+                .map(|(b, runs)| Timed {
+                    slowest_samples_per_s: least(&runs),
+                    runs,
                     ..b.expect("at least one repetition")
                 })
                 .collect()
@@ -216,10 +220,10 @@ fn least(x: &[f64]) -> f64 {
     x.iter().copied().fold(f64::INFINITY, f64::min)
 }
 
-/// The median over repetitions of `last[k] / first[k]`: both costs of a ratio were timed in
+/// The median over repetitions of `last[k] / first[k]`: both numbers of a ratio were timed in
 /// the same repetition, minutes apart at most, so a drift of the machine's speed between
 /// repetitions cancels.
-fn paired_growth(first: &[f64], last: &[f64]) -> f64 {
+fn paired_ratio(first: &[f64], last: &[f64]) -> f64 {
     use statrs::statistics::{Data, Median};
     let ratios: Vec<f64> = first.iter().zip(last).map(|(f, l)| l / f).collect();
     Data::new(ratios).median()
@@ -324,7 +328,8 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         let timed = throughputs(&scene, &strategies, a.spp, &a.threads, a.repeat);
         for (&strategy, all) in strategies.iter().zip(timed) {
             let by_threads: Vec<(usize, Timed)> = a.threads.iter().copied().zip(all).collect();
-            for &(threads, timed) in &by_threads {
+            for (threads, timed) in &by_threads {
+                let threads = *threads;
                 println!(
                     "  {:<34} {:<26} {:>7} {:>12.2}  {:.2} ({:.0}% below)",
                     name,
@@ -353,22 +358,27 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             // causes: the speed-up is t2/t1 x (busy share ratio) / (work per sample ratio).
             let lo = by_threads.iter().min_by_key(|t| t.0);
             let hi = by_threads.iter().max_by_key(|t| t.0);
-            if let (Some(&(t1, s1)), Some(&(t2, s2))) = (lo, hi) {
+            if let (Some((t1, s1)), Some((t2, s2))) = (lo, hi) {
+                let (t1, t2) = (*t1, *t2);
                 if t2 > t1 {
                     let speed_up = s2.samples_per_s / s1.samples_per_s;
+                    // Each repetition's own ratio: its two renders ran back to back.
+                    let paired = paired_ratio(&s1.runs, &s2.runs);
                     first_speed_up.get_or_insert((t2, speed_up));
                     let work = s2.work_per_sample / s1.work_per_sample;
                     println!(
-                        "  {:<34} {:<26} {:>7} {:>11.2}x  (workers busy {:.1}%, work per sample {:.3}x the {t1}-thread's)",
+                        "  {:<34} {:<26} {:>7} {:>11.2}x  (paired median {:.2}x; workers busy {:.1}%, work per sample {:.3}x the {t1}-thread's)",
                         "",
                         "",
                         format!("{t1}->{t2}"),
                         speed_up,
+                        paired,
                         s2.busy * 100.0,
                         work,
                     );
                     for (section, value, unit) in [
                         ("thread_scaling", speed_up, "speed-up"),
+                        ("thread_scaling_paired", paired, "speed-up"),
                         ("thread_busy", s2.busy, "fraction"),
                         ("thread_work_per_sample", work, "ratio"),
                     ] {
@@ -535,7 +545,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
     }
     drop(scenes);
     if let (Some(first), Some(last)) = (costs.first(), costs.last()) {
-        let (growth, paired) = (least(last) / least(first), paired_growth(first, last));
+        let (growth, paired) = (least(last) / least(first), paired_ratio(first, last));
         println!(
             "  growth over the sweep: {growth:.2}x best against best, {paired:.2}x the median of the {} repetitions' own ratios",
             first.len()
@@ -680,7 +690,11 @@ mod tests {
                 let slowest = timed.slowest_samples_per_s;
                 assert!(close(slowest, want / 2.0), "{k} {j}: {slowest}");
                 assert!(close(timed.busy, 0.5), "{k} {j}: {}", timed.busy);
+                assert_eq!(timed.runs.len(), 4);
             }
+            // The slow first repetition slows both thread counts: it cancels in its ratio.
+            let paired = paired_ratio(&row[0].runs, &row[1].runs);
+            assert!((paired - 2.0).abs() < 1e-12, "{k}: {paired}");
         }
     }
 
@@ -706,6 +720,6 @@ mod tests {
         assert_eq!(costs[0], [202.0, 101.0, 101.0, 101.0, 101.0]);
         assert_eq!(costs[2], [400.0, 200.0, 600.0, 200.0, 200.0]);
         assert_eq!(least(&costs[2]), 200.0);
-        assert!((paired_growth(&costs[0], &costs[2]) - 200.0 / 101.0).abs() < 1e-12);
+        assert!((paired_ratio(&costs[0], &costs[2]) - 200.0 / 101.0).abs() < 1e-12);
     }
 }
