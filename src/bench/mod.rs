@@ -216,6 +216,25 @@ fn costs_in_turns<T>(items: &[T], repeat: u32, mut cost: impl FnMut(&T) -> f64) 
     out
 }
 
+/// A sweep's scenes, one per count, and each one's ns per sample in every repetition
+/// (`costs_in_turns`), rendered with `strategy` at `--sweep-spp` on `threads` threads.
+fn sweep(
+    counts: &[usize],
+    desc: fn(usize) -> crate::scene::desc::SceneDesc,
+    strategy: Strategy,
+    a: &BenchArgs,
+    threads: usize,
+) -> Result<(Vec<crate::scene::Scene>, Vec<Vec<f64>>), String> {
+    let scenes = counts
+        .iter()
+        .map(|&n| crate::scene::Scene::build(desc(n)).map_err(|e| e.to_string()))
+        .collect::<Result<Vec<_>, _>>()?;
+    let costs = costs_in_turns(&scenes, a.repeat, |scene| {
+        1e9 / throughput(scene, strategy, a.sweep_spp, threads, 1)
+    });
+    Ok((scenes, costs))
+}
+
 fn least(x: &[f64]) -> f64 {
     x.iter().copied().fold(f64::INFINITY, f64::min)
 }
@@ -328,8 +347,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         let timed = throughputs(&scene, &strategies, a.spp, &a.threads, a.repeat);
         for (&strategy, all) in strategies.iter().zip(timed) {
             let by_threads: Vec<(usize, Timed)> = a.threads.iter().copied().zip(all).collect();
-            for (threads, timed) in &by_threads {
-                let threads = *threads;
+            for &(threads, ref timed) in &by_threads {
                 println!(
                     "  {:<34} {:<26} {:>7} {:>12.2}  {:.2} ({:.0}% below)",
                     name,
@@ -358,8 +376,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             // causes: the speed-up is t2/t1 x (busy share ratio) / (work per sample ratio).
             let lo = by_threads.iter().min_by_key(|t| t.0);
             let hi = by_threads.iter().max_by_key(|t| t.0);
-            if let (Some((t1, s1)), Some((t2, s2))) = (lo, hi) {
-                let (t1, t2) = (*t1, *t2);
+            if let (Some(&(t1, ref s1)), Some(&(t2, ref s2))) = (lo, hi) {
                 if t2 > t1 {
                     let speed_up = s2.samples_per_s / s1.samples_per_s;
                     // Each repetition's own ratio: its two renders ran back to back.
@@ -522,13 +539,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         .into_iter()
         .filter(|&n| n <= a.max_triangles)
         .collect();
-    let scenes = counts
-        .iter()
-        .map(|&n| crate::scene::Scene::build(scaling::tessellated(n)).map_err(|e| e.to_string()))
-        .collect::<Result<Vec<_>, _>>()?;
-    let costs = costs_in_turns(&scenes, a.repeat, |scene| {
-        1e9 / throughput(scene, mis, a.sweep_spp, max_threads, 1)
-    });
+    let (scenes, costs) = sweep(&counts, scaling::tessellated, mis, a, max_threads)?;
     for (scene, c) in scenes.iter().zip(&costs) {
         let tris = scene.accel.primitive_count() as u64;
         let best = least(c);
@@ -571,15 +582,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             .into_iter()
             .filter(|&n| n <= a.max_emitters)
             .collect();
-        let scenes = counts
-            .iter()
-            .map(|&n| {
-                crate::scene::Scene::build(scaling::many_lights(n)).map_err(|e| e.to_string())
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let costs = costs_in_turns(&scenes, a.repeat, |scene| {
-            1e9 / throughput(scene, s, a.sweep_spp, max_threads, 1)
-        });
+        let (scenes, costs) = sweep(&counts, scaling::many_lights, s, a, max_threads)?;
         for (&n, c) in counts.iter().zip(&costs) {
             let best = least(c);
             println!(
