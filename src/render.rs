@@ -253,8 +253,10 @@ mod tests {
         let tent = |d: &mut SceneDesc| d.film.filter = FilterDesc::Tent { radius: 1.0 };
         let keep = |_: &mut SceneDesc| {};
         type Edit = dyn Fn(&mut SceneDesc);
-        let cases: [(&str, &Edit, crate::integrator::Strategy, bool); 6] = [
+        let cases: [(&str, &Edit, crate::integrator::Strategy, bool); 7] = [
             ("cbox/cbox.xml", &keep, mis, true),
+            // A light mesh of many triangles: the lanes' per-triangle records.
+            ("cbox-meshlight/cbox-meshlight.xml", &keep, power, true),
             (
                 "cbox/cbox.xml",
                 &keep,

@@ -181,9 +181,20 @@ impl Accel {
     /// such ray meets it again; a sphere can be met again (from inside), so nothing is skipped.
     #[inline]
     pub fn skip_id(&self, sp: &SurfacePoint) -> u32 {
-        match self.tri_base[sp.shape as usize] {
+        Accel::skip_from(self.skip_base(sp.shape), sp.prim)
+    }
+
+    /// The part of `skip_id` that depends on the shape alone, for tables built per shape.
+    pub fn skip_base(&self, shape: u32) -> u32 {
+        self.tri_base[shape as usize]
+    }
+
+    /// `skip_id` from the shape's `skip_base` and the point's triangle.
+    #[inline(always)]
+    pub fn skip_from(base: u32, prim: u32) -> u32 {
+        match base {
             NO_SKIP => NO_SKIP,
-            base => base + sp.prim,
+            base => base + prim,
         }
     }
 

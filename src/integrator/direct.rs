@@ -9,7 +9,7 @@
 //! sampling only) are handled by that technique with weight 1 in every strategy, including
 //! the pure ones, so no strategy loses them and none counts them twice.
 
-use super::lanes::{lane_lights, LaneLight};
+use super::lanes::{lane_setup, Lanes};
 use super::Strategy;
 use crate::bsdf::{BsdfSample, Material};
 use crate::emitter::{EmitterSelector, LightSample};
@@ -26,7 +26,7 @@ pub struct Direct<'a> {
     pub(super) selector: EmitterSelector,
     has_delta_lights: bool,
     /// Set when `li_lanes` covers the scene and strategy.
-    pub(super) lane_lights: Option<Vec<LaneLight<'a>>>,
+    pub(super) lanes: Option<Lanes<'a>>,
 }
 
 #[inline]
@@ -57,7 +57,7 @@ impl<'a> Direct<'a> {
             strategy,
             selector: EmitterSelector::new(&scene.emitters, strategy.selection),
             has_delta_lights: scene.emitters.iter().any(|e| e.is_delta()),
-            lane_lights: lane_lights(scene, &strategy),
+            lanes: lane_setup(scene, &strategy),
         }
     }
 

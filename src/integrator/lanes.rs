@@ -25,7 +25,7 @@ use crate::bsdf::{BsdfKind, BsdfSample, Diffuse, RoughConductor};
 use crate::emitter::{
     area_pdf_along, sample_at, sphere_area_point, AreaLight, Emitter, LightSampling,
 };
-use crate::geometry::{Mesh, Ray, ShapeKind, Sphere, SurfacePoint, NO_SKIP};
+use crate::geometry::{Accel, Mesh, Ray, ShapeKind, Sphere, SurfacePoint, NO_SKIP};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
 use crate::sampling::microfacet::MicrofacetDistribution;
@@ -59,12 +59,13 @@ impl V3x8 {
 }
 
 /// An emitter the lanes can sample: an area light and its shape (for a mesh, with its
-/// triangle table).
+/// triangle table and its triangles' records).
 pub(super) enum LaneLight<'a> {
     Mesh {
         light: &'a AreaLight,
         mesh: &'a Mesh,
         triangles: &'a AliasTable,
+        records: Vec<LightTriangle>,
     },
     Sphere {
         light: &'a AreaLight,
@@ -72,9 +73,94 @@ pub(super) enum LaneLight<'a> {
     },
 }
 
+/// What `light_draws` reads of a light triangle, in one 64-byte record: `Mesh` keeps the
+/// vertices behind an index array and the face in a third table, three or four cache lines
+/// apart.
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+pub(super) struct LightTriangle {
+    v: [Vec3; 3],
+    ng: Vec3,
+    err: Vec3,
+}
+
+impl LightTriangle {
+    fn of(mesh: &Mesh, tri: usize) -> Self {
+        let (ng, err) = mesh.face(tri);
+        LightTriangle {
+            v: mesh.vertices(tri),
+            ng,
+            err,
+        }
+    }
+}
+
+/// How the lanes shade a hit's material.
+#[derive(Clone, Copy)]
+enum LaneMaterial {
+    /// One-sided diffuse, with its reflectance.
+    Diffuse(Vec3),
+    /// A rough conductor `lanes_rough` covers: specular reflectance, roughness, grey index.
+    Rough {
+        reflectance: Vec3,
+        alpha: (f32, f32),
+        eta_k: (f32, f32),
+    },
+    /// Left to the scalar path.
+    Other,
+}
+
+/// What `camera_hits` needs of a hit's shape, in one lookup where `Scene::material`,
+/// `Scene::emitter_at` and the two `skip_id`s read five tables.
+#[derive(Clone, Copy)]
+pub(super) struct LaneShape {
+    material: LaneMaterial,
+    emitter: Option<u32>,
+    skip_base: u32,
+    emitter_skip_base: u32,
+}
+
+/// The tables of the lanes: one light per emitter, one record per shape.
+pub(super) struct Lanes<'a> {
+    lights: Vec<LaneLight<'a>>,
+    shapes: Vec<LaneShape>,
+}
+
+/// The lanes' tables if the scene and strategy are the configuration the lanes cover;
+/// otherwise None and `Direct` shades every sample with `li`.
+pub(super) fn lane_setup<'a>(scene: &'a Scene, s: &Strategy) -> Option<Lanes<'a>> {
+    let lights = lane_lights(scene, s)?;
+    let shapes = (0..scene.shapes.len() as u32)
+        .map(|shape| {
+            let sh = &scene.shapes[shape as usize];
+            let mat = &scene.materials[sh.material as usize];
+            let material = match &mat.kind {
+                _ if mat.two_sided => LaneMaterial::Other,
+                BsdfKind::Diffuse(diffuse) => LaneMaterial::Diffuse(diffuse.reflectance),
+                BsdfKind::RoughConductor(rc) if rough_covered(rc) => LaneMaterial::Rough {
+                    reflectance: rc.specular_reflectance,
+                    alpha: (rc.mf.alpha_u, rc.mf.alpha_v),
+                    eta_k: (rc.eta.x, rc.k.x),
+                },
+                _ => LaneMaterial::Other,
+            };
+            LaneShape {
+                material,
+                emitter: sh.emitter,
+                skip_base: scene.accel.skip_base(shape),
+                emitter_skip_base: scene
+                    .emitter_accel
+                    .as_ref()
+                    .map_or(NO_SKIP, |e| e.skip_base(shape)),
+            }
+        })
+        .collect();
+    Some(Lanes { lights, shapes })
+}
+
 /// The lane lights, one per emitter, if the scene and strategy are the configuration the
-/// lanes cover; otherwise None and `Direct` shades every sample with `li`.
-pub(super) fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>> {
+/// lanes cover.
+fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>> {
     let covered = s.kind == StrategyKind::Mis
         && s.emitter_samples == 1
         && s.bsdf_samples == 1
@@ -93,6 +179,9 @@ pub(super) fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<Lane
                         light,
                         mesh,
                         triangles,
+                        records: (0..triangles.len())
+                            .map(|t| LightTriangle::of(mesh, t))
+                            .collect(),
                     }),
                     (ShapeKind::Sphere(sphere), _) => Some(LaneLight::Sphere { light, sphere }),
                     _ => None,
@@ -171,20 +260,20 @@ impl Direct<'_> {
     /// `li` of the first `n` rays, each with its lane of `rng` (which must stand where `li`
     /// would receive it): in lanes where they cover the scene and strategy, else one by one.
     pub fn li_lanes(&self, rays: &[Ray; LANES], n: usize, rng: &mut RngLanes) -> [Rgb; LANES] {
-        let Some(lights) = self.lane_lights.as_deref() else {
+        let Some(lanes) = &self.lanes else {
             return std::array::from_fn(|i| match i < n {
                 true => self.li(&rays[i], &mut rng.lane(i)),
                 false => Rgb::ZERO,
             });
         };
         let mut out = [Rgb::ZERO; LANES];
-        let hits = self.camera_hits(rays, n, rng, &mut out);
+        let hits = self.camera_hits(&lanes.shapes, rays, n, rng, &mut out);
         // The seven numbers `li` draws after the camera's: light (emitter, triangle, point),
         // then BSDF (lobe, direction).
         let u: [[f32; LANES]; 7] = std::array::from_fn(|_| rng.next_f32());
         // Filled in place: returned by value, the draws were copied (a 1 kB memcpy).
         let (mut draws, mut spheres) = (LightDraws::default(), SphereDraws::default());
-        self.light_draws(lights, &u[0], &u[1], &mut draws, &mut spheres);
+        self.light_draws(&lanes.lights, &u[0], &u[1], &mut draws, &mut spheres);
         // Sphere lights take a branch per lane, which the mesh-only loop is spared.
         match (hits.rough, spheres.any) {
             (true, _) => self.shade_and_trace_rough(&hits, &draws, &spheres, &u, &mut out),
@@ -196,13 +285,14 @@ impl Direct<'_> {
 
     /// Whether `li_lanes` shades in lanes for this scene and strategy.
     pub fn has_lanes(&self) -> bool {
-        self.lane_lights.is_some()
+        self.lanes.is_some()
     }
 
     /// Camera hits; lanes the kernel does not cover are finished here by `li_hit`.
     #[inline(always)]
     fn camera_hits(
         &self,
+        shapes: &[LaneShape],
         rays: &[Ray; LANES],
         n: usize,
         rng: &RngLanes,
@@ -217,22 +307,25 @@ impl Direct<'_> {
                 continue;
             };
             let sp = hit.sp;
-            let mat = scene.material(&sp);
+            let shape = &shapes[sp.shape as usize];
             // The batch takes the kind of its first covered hit; hits of the other kind (at a
             // pixel straddling two materials) and uncovered materials take the scalar path.
-            let rough = match &mat.kind {
-                _ if mat.two_sided => None,
-                BsdfKind::Diffuse(diffuse) => {
-                    h.reflectance.set(i, diffuse.reflectance);
+            let rough = match shape.material {
+                LaneMaterial::Diffuse(reflectance) => {
+                    h.reflectance.set(i, reflectance);
                     Some(false)
                 }
-                BsdfKind::RoughConductor(rc) if rough_covered(rc) => {
-                    h.reflectance.set(i, rc.specular_reflectance);
-                    (h.alpha_u[i], h.alpha_v[i]) = (rc.mf.alpha_u, rc.mf.alpha_v);
-                    (h.eta[i], h.k[i]) = (rc.eta.x, rc.k.x);
+                LaneMaterial::Rough {
+                    reflectance,
+                    alpha,
+                    eta_k,
+                } => {
+                    h.reflectance.set(i, reflectance);
+                    (h.alpha_u[i], h.alpha_v[i]) = alpha;
+                    (h.eta[i], h.k[i]) = eta_k;
                     Some(true)
                 }
-                _ => None,
+                LaneMaterial::Other => None,
             };
             if rough.is_none_or(|r| r != *batch.get_or_insert(r)) {
                 out[i] = self.li_hit(&rays[i], &sp, &mut rng.lane(i));
@@ -240,8 +333,8 @@ impl Direct<'_> {
             }
             let mut l = Rgb::ZERO;
             if !self.strategy.hide_emitters {
-                if let Some((_, e)) = scene.emitter_at(&sp) {
-                    l += e.le(&sp, -rays[i].d);
+                if let Some(e) = shape.emitter {
+                    l += scene.emitters[e as usize].le(&sp, -rays[i].d);
                 }
             }
             h.l[i] = Some(l);
@@ -250,11 +343,8 @@ impl Direct<'_> {
             h.ns.set(i, sp.ns);
             h.err.set(i, sp.err_scale);
             h.d.set(i, rays[i].d);
-            h.skip[i] = scene.accel.skip_id(&sp);
-            h.emitter_skip[i] = scene
-                .emitter_accel
-                .as_ref()
-                .map_or(NO_SKIP, |e| e.skip_id(&sp));
+            h.skip[i] = Accel::skip_from(shape.skip_base, sp.prim);
+            h.emitter_skip[i] = Accel::skip_from(shape.emitter_skip_base, sp.prim);
         }
         h.rough = batch == Some(true);
         h
@@ -279,18 +369,21 @@ impl Direct<'_> {
             d.radiance.set(i, light.radiance);
             d.area[i] = light.area;
             d.pmf[i] = pmf;
-            let (mesh, triangles) = match &lights[e] {
+            let (mesh, triangles, records) = match &lights[e] {
                 LaneLight::Mesh {
-                    mesh, triangles, ..
-                } => (mesh, triangles),
+                    mesh,
+                    triangles,
+                    records,
+                    ..
+                } => (mesh, triangles, records),
                 LaneLight::Sphere { sphere, .. } => {
                     (spheres.sphere[i], spheres.any) = (Some(**sphere), true);
                     continue;
                 }
             };
             let tri = triangles.sample(u_tri[i]);
-            let (ng, err) = mesh.face(tri);
-            for (k, v) in mesh.vertices(tri).into_iter().enumerate() {
+            let r = &records[tri];
+            for (k, v) in r.v.into_iter().enumerate() {
                 d.v[k].set(i, v);
             }
             if let Some(n) = mesh.vertex_normals(tri) {
@@ -299,8 +392,8 @@ impl Direct<'_> {
                 }
                 d.has_normals[i] = true;
             }
-            d.ng.set(i, ng);
-            d.err.set(i, err);
+            d.ng.set(i, r.ng);
+            d.err.set(i, r.err);
             d.tri[i] = tri as u32;
         }
     }
