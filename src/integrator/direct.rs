@@ -9,7 +9,7 @@
 //! sampling only) are handled by that technique with weight 1 in every strategy, including
 //! the pure ones, so no strategy loses them and none counts them twice.
 
-use super::lanes::{lane_setup, Lanes};
+use super::lane_tables::{lane_setup, Lanes};
 use super::Strategy;
 use crate::bsdf::{BsdfSample, Material};
 use crate::emitter::{EmitterSelector, LightSample};

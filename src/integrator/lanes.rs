@@ -12,26 +12,20 @@
 //! area sampling, every emitter an area light on a mesh or a sphere. Camera hits on one-sided
 //! diffuse surfaces shade here; batches of one-sided Beckmann rough conductors shade in
 //! `lanes_rough`. Other hits go to `li_hit`, the scalar definition; other configurations go
-//! to `li`.
+//! to `li`. The tables its lookups read are built once per render in `lane_tables`.
 
 // Lane loops index a dozen structure-of-arrays fields by the same lane number; iterators
 // over one of them would hide that symmetry.
 #![allow(clippy::needless_range_loop)]
 
 use super::direct::{heuristic, Direct};
-use super::Strategy;
-use crate::bsdf::fresnel::is_grey;
-use crate::bsdf::{BsdfKind, BsdfSample, Diffuse, RoughConductor};
-use crate::emitter::{
-    area_pdf_along, sample_at, sphere_area_point, AreaLight, Emitter, LightSampling,
-};
-use crate::geometry::{Accel, Mesh, Ray, ShapeKind, Sphere, SurfacePoint, NO_SKIP};
+use super::lane_tables::{LaneLight, LaneMaterial, LaneShape};
+use crate::bsdf::{BsdfSample, Diffuse};
+use crate::emitter::{area_pdf_along, sample_at, sphere_area_point};
+use crate::geometry::{Accel, Mesh, Ray, Sphere, SurfacePoint};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
-use crate::sampling::microfacet::MicrofacetDistribution;
 use crate::sampling::warps::square_to_uniform_triangle;
-use crate::sampling::AliasTable;
-use crate::scene::desc::StrategyKind;
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 
@@ -56,140 +50,6 @@ impl V3x8 {
     pub(super) fn set(&mut self, i: usize, v: Vec3) {
         (self.x[i], self.y[i], self.z[i]) = (v.x, v.y, v.z);
     }
-}
-
-/// An emitter the lanes can sample: an area light and its shape (for a mesh, with its
-/// triangle table and its triangles' records).
-pub(super) enum LaneLight<'a> {
-    Mesh {
-        light: &'a AreaLight,
-        mesh: &'a Mesh,
-        triangles: &'a AliasTable,
-        records: Vec<LightTriangle>,
-    },
-    Sphere {
-        light: &'a AreaLight,
-        sphere: &'a Sphere,
-    },
-}
-
-/// What `light_draws` reads of a light triangle, in one 64-byte record: `Mesh` keeps the
-/// vertices behind an index array and the face in a third table, three or four cache lines
-/// apart.
-#[derive(Clone, Copy)]
-#[repr(C, align(64))]
-pub(super) struct LightTriangle {
-    v: [Vec3; 3],
-    ng: Vec3,
-    err: Vec3,
-}
-
-impl LightTriangle {
-    fn of(mesh: &Mesh, tri: usize) -> Self {
-        let (ng, err) = mesh.face(tri);
-        LightTriangle {
-            v: mesh.vertices(tri),
-            ng,
-            err,
-        }
-    }
-}
-
-/// How the lanes shade a hit's material.
-#[derive(Clone, Copy)]
-enum LaneMaterial {
-    /// One-sided diffuse, with its reflectance.
-    Diffuse(Vec3),
-    /// A rough conductor `lanes_rough` covers: specular reflectance, roughness, grey index.
-    Rough {
-        reflectance: Vec3,
-        alpha: (f32, f32),
-        eta_k: (f32, f32),
-    },
-    /// Left to the scalar path.
-    Other,
-}
-
-/// What `camera_hits` needs of a hit's shape, in one lookup where `Scene::material`,
-/// `Scene::emitter_at` and the two `skip_id`s read five tables.
-#[derive(Clone, Copy)]
-pub(super) struct LaneShape {
-    material: LaneMaterial,
-    emitter: Option<u32>,
-    skip_base: u32,
-    emitter_skip_base: u32,
-}
-
-/// The tables of the lanes: one light per emitter, one record per shape.
-pub(super) struct Lanes<'a> {
-    lights: Vec<LaneLight<'a>>,
-    shapes: Vec<LaneShape>,
-}
-
-/// The lanes' tables if the scene and strategy are the configuration the lanes cover;
-/// otherwise None and `Direct` shades every sample with `li`.
-pub(super) fn lane_setup<'a>(scene: &'a Scene, s: &Strategy) -> Option<Lanes<'a>> {
-    let lights = lane_lights(scene, s)?;
-    let shapes = (0..scene.shapes.len() as u32)
-        .map(|shape| {
-            let sh = &scene.shapes[shape as usize];
-            let mat = &scene.materials[sh.material as usize];
-            let material = match &mat.kind {
-                _ if mat.two_sided => LaneMaterial::Other,
-                BsdfKind::Diffuse(diffuse) => LaneMaterial::Diffuse(diffuse.reflectance),
-                BsdfKind::RoughConductor(rc) if rough_covered(rc) => LaneMaterial::Rough {
-                    reflectance: rc.specular_reflectance,
-                    alpha: (rc.mf.alpha_u, rc.mf.alpha_v),
-                    eta_k: (rc.eta.x, rc.k.x),
-                },
-                _ => LaneMaterial::Other,
-            };
-            LaneShape {
-                material,
-                emitter: sh.emitter,
-                skip_base: scene.accel.skip_base(shape),
-                emitter_skip_base: scene
-                    .emitter_accel
-                    .as_ref()
-                    .map_or(NO_SKIP, |e| e.skip_base(shape)),
-            }
-        })
-        .collect();
-    Some(Lanes { lights, shapes })
-}
-
-/// The lane lights, one per emitter, if the scene and strategy are the configuration the
-/// lanes cover.
-fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>> {
-    let covered = s.kind == StrategyKind::Mis
-        && s.emitter_samples == 1
-        && s.bsdf_samples == 1
-        && s.light_sampling == LightSampling::Area
-        && !scene.emitters.is_empty();
-    if !covered {
-        return None;
-    }
-    scene
-        .emitters
-        .iter()
-        .map(|e| match e {
-            Emitter::Area(light) => {
-                match (&scene.shapes[light.shape as usize].kind, &light.triangles) {
-                    (ShapeKind::Mesh(mesh), Some(triangles)) => Some(LaneLight::Mesh {
-                        light,
-                        mesh,
-                        triangles,
-                        records: (0..triangles.len())
-                            .map(|t| LightTriangle::of(mesh, t))
-                            .collect(),
-                    }),
-                    (ShapeKind::Sphere(sphere), _) => Some(LaneLight::Sphere { light, sphere }),
-                    _ => None,
-                }
-            }
-            Emitter::Point(_) => None,
-        })
-        .collect()
 }
 
 /// What the camera hits of the eight samples leave for shading.
@@ -555,12 +415,4 @@ pub(super) fn light_sample<const SPHERES: bool>(
         Some(ls) => (true, ls.wi, ls.pdf, ls.li, lsp),
         None => (false, Vec3::ZERO, 0.0, Rgb::ZERO, lsp),
     }
-}
-
-/// Rough conductors the lanes shade (`lanes_rough`): Beckmann with visible-normal sampling
-/// and a grey index (one Fresnel channel), the Veach scene's plates.
-fn rough_covered(rc: &RoughConductor) -> bool {
-    rc.mf.distribution == MicrofacetDistribution::Beckmann
-        && rc.sample_visible
-        && is_grey(rc.eta, rc.k)
 }

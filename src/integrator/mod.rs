@@ -1,6 +1,7 @@
 //! Direct-illumination estimators: light sampling, BSDF sampling and their MIS combinations.
 
 mod direct;
+mod lane_tables;
 mod lanes;
 mod lanes_rough;
 mod strategy;

@@ -1,0 +1,262 @@
+//! The tables the lane kernel (`lanes`) reads, built once per render: the lights it can sample
+//! (one 64-byte record per light triangle) and one row per shape (its material as the lanes
+//! shade it, its emitter and its skip-id bases), so that a lane's lookups touch one table each
+//! where the scene keeps the same data in several.
+
+use super::Strategy;
+use crate::bsdf::fresnel::is_grey;
+use crate::bsdf::{BsdfKind, RoughConductor};
+use crate::emitter::{AreaLight, Emitter, LightSampling};
+use crate::geometry::{Mesh, ShapeKind, Sphere, NO_SKIP};
+use crate::sampling::microfacet::MicrofacetDistribution;
+use crate::sampling::AliasTable;
+use crate::scene::desc::StrategyKind;
+use crate::scene::Scene;
+use glam::Vec3;
+
+/// An emitter the lanes can sample: an area light and its shape (for a mesh, with its
+/// triangle table and its triangles' records).
+pub(super) enum LaneLight<'a> {
+    Mesh {
+        light: &'a AreaLight,
+        mesh: &'a Mesh,
+        triangles: &'a AliasTable,
+        records: Vec<LightTriangle>,
+    },
+    Sphere {
+        light: &'a AreaLight,
+        sphere: &'a Sphere,
+    },
+}
+
+/// What `light_draws` reads of a light triangle, in one 64-byte record: `Mesh` keeps the
+/// vertices behind an index array and the face in a third table, three or four cache lines
+/// apart.
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+pub(super) struct LightTriangle {
+    pub(super) v: [Vec3; 3],
+    pub(super) ng: Vec3,
+    pub(super) err: Vec3,
+}
+
+impl LightTriangle {
+    fn of(mesh: &Mesh, tri: usize) -> Self {
+        let (ng, err) = mesh.face(tri);
+        LightTriangle {
+            v: mesh.vertices(tri),
+            ng,
+            err,
+        }
+    }
+}
+
+/// How the lanes shade a hit's material.
+#[derive(Clone, Copy)]
+pub(super) enum LaneMaterial {
+    /// One-sided diffuse, with its reflectance.
+    Diffuse(Vec3),
+    /// A rough conductor `lanes_rough` covers: specular reflectance, roughness, grey index.
+    Rough {
+        reflectance: Vec3,
+        alpha: (f32, f32),
+        eta_k: (f32, f32),
+    },
+    /// Left to the scalar path.
+    Other,
+}
+
+/// What `camera_hits` needs of a hit's shape, in one lookup where `Scene::material`,
+/// `Scene::emitter_at` and the two `skip_id`s read five tables.
+#[derive(Clone, Copy)]
+pub(super) struct LaneShape {
+    pub(super) material: LaneMaterial,
+    pub(super) emitter: Option<u32>,
+    pub(super) skip_base: u32,
+    pub(super) emitter_skip_base: u32,
+}
+
+/// The tables of the lanes: one light per emitter, one record per shape.
+pub(super) struct Lanes<'a> {
+    pub(super) lights: Vec<LaneLight<'a>>,
+    pub(super) shapes: Vec<LaneShape>,
+}
+
+/// The lanes' tables if the scene and strategy are the configuration the lanes cover;
+/// otherwise None and `Direct` shades every sample with `li`.
+pub(super) fn lane_setup<'a>(scene: &'a Scene, s: &Strategy) -> Option<Lanes<'a>> {
+    let lights = lane_lights(scene, s)?;
+    let shapes = (0..scene.shapes.len() as u32)
+        .map(|shape| {
+            let sh = &scene.shapes[shape as usize];
+            let mat = &scene.materials[sh.material as usize];
+            let material = match &mat.kind {
+                _ if mat.two_sided => LaneMaterial::Other,
+                BsdfKind::Diffuse(diffuse) => LaneMaterial::Diffuse(diffuse.reflectance),
+                BsdfKind::RoughConductor(rc) if rough_covered(rc) => LaneMaterial::Rough {
+                    reflectance: rc.specular_reflectance,
+                    alpha: (rc.mf.alpha_u, rc.mf.alpha_v),
+                    eta_k: (rc.eta.x, rc.k.x),
+                },
+                _ => LaneMaterial::Other,
+            };
+            LaneShape {
+                material,
+                emitter: sh.emitter,
+                skip_base: scene.accel.skip_base(shape),
+                emitter_skip_base: scene
+                    .emitter_accel
+                    .as_ref()
+                    .map_or(NO_SKIP, |e| e.skip_base(shape)),
+            }
+        })
+        .collect();
+    Some(Lanes { lights, shapes })
+}
+
+/// The lane lights, one per emitter, if the scene and strategy are the configuration the
+/// lanes cover.
+fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>> {
+    let covered = s.kind == StrategyKind::Mis
+        && s.emitter_samples == 1
+        && s.bsdf_samples == 1
+        && s.light_sampling == LightSampling::Area
+        && !scene.emitters.is_empty();
+    if !covered {
+        return None;
+    }
+    scene
+        .emitters
+        .iter()
+        .map(|e| match e {
+            Emitter::Area(light) => {
+                match (&scene.shapes[light.shape as usize].kind, &light.triangles) {
+                    (ShapeKind::Mesh(mesh), Some(triangles)) => Some(LaneLight::Mesh {
+                        light,
+                        mesh,
+                        triangles,
+                        records: (0..triangles.len())
+                            .map(|t| LightTriangle::of(mesh, t))
+                            .collect(),
+                    }),
+                    (ShapeKind::Sphere(sphere), _) => Some(LaneLight::Sphere { light, sphere }),
+                    _ => None,
+                }
+            }
+            Emitter::Point(_) => None,
+        })
+        .collect()
+}
+
+/// Rough conductors the lanes shade (`lanes_rough`): Beckmann with visible-normal sampling
+/// and a grey index (one Fresnel channel), the Veach scene's plates.
+pub(super) fn rough_covered(rc: &RoughConductor) -> bool {
+    rc.mf.distribution == MicrofacetDistribution::Beckmann
+        && rc.sample_visible
+        && is_grey(rc.eta, rc.k)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{Accel, SurfacePoint};
+    use crate::integrator::Strategy;
+    use crate::scene::bundled_tests::load;
+
+    fn mis() -> Strategy {
+        Strategy::combinations()
+            .into_iter()
+            .find(|s| s.kind == StrategyKind::Mis && s.emitter_samples == 1)
+            .unwrap()
+    }
+
+    /// Each shape's row says what the scene's own tables say: the material as the lanes
+    /// classify it, the emitter, and skip ids equal to `Accel::skip_id` for its triangles.
+    #[test]
+    fn shape_rows_agree_with_the_scene() {
+        for rel in [
+            "cbox-materials/cbox-materials.xml",
+            "veach-mis/veach-mis.xml",
+        ] {
+            let mut desc = load(rel);
+            // Point lights send a scene to the scalar path.
+            desc.point_lights.clear();
+            let scene = Scene::build(desc).unwrap();
+            let lanes = lane_setup(&scene, &mis()).expect("covered");
+            assert_eq!(lanes.shapes.len(), scene.shapes.len());
+            let mut kinds = [0; 3];
+            for (i, (row, shape)) in lanes.shapes.iter().zip(&scene.shapes).enumerate() {
+                let mat = &scene.materials[shape.material as usize];
+                let k = match (&row.material, &mat.kind) {
+                    (LaneMaterial::Diffuse(r), BsdfKind::Diffuse(d)) => {
+                        assert!(!mat.two_sided && *r == d.reflectance, "{rel} shape {i}");
+                        0
+                    }
+                    (LaneMaterial::Rough { reflectance, .. }, BsdfKind::RoughConductor(rc)) => {
+                        assert!(!mat.two_sided && rough_covered(rc), "{rel} shape {i}");
+                        assert_eq!(*reflectance, rc.specular_reflectance);
+                        1
+                    }
+                    (LaneMaterial::Other, kind) => {
+                        let covered = matches!(kind, BsdfKind::Diffuse(_))
+                            || matches!(kind, BsdfKind::RoughConductor(rc) if rough_covered(rc));
+                        assert!(mat.two_sided || !covered, "{rel} shape {i}");
+                        2
+                    }
+                    _ => panic!("{rel} shape {i}: row and material of different kinds"),
+                };
+                kinds[k] += 1;
+                assert_eq!(row.emitter, shape.emitter);
+                let prims = match &shape.kind {
+                    ShapeKind::Mesh(m) => m.indices.len() as u32,
+                    ShapeKind::Sphere(_) => 1,
+                };
+                for prim in [0, prims / 2, prims - 1] {
+                    let sp = SurfacePoint {
+                        p: Vec3::ZERO,
+                        ng: Vec3::Z,
+                        ns: Vec3::Z,
+                        shape: i as u32,
+                        prim,
+                        err_scale: Vec3::ZERO,
+                    };
+                    let emitter_skip = scene.emitter_accel.as_ref().map(|e| e.skip_id(&sp));
+                    assert_eq!(
+                        Accel::skip_from(row.skip_base, prim),
+                        scene.accel.skip_id(&sp)
+                    );
+                    assert_eq!(
+                        Accel::skip_from(row.emitter_skip_base, prim),
+                        emitter_skip.unwrap_or(NO_SKIP)
+                    );
+                }
+            }
+            assert!(kinds[0] > 0, "{rel}: {kinds:?}");
+            if rel.starts_with("cbox") {
+                assert!(kinds[2] > 0, "{rel}: uncovered materials {kinds:?}");
+            } else {
+                assert!(kinds[1] > 0, "{rel}: rough plates {kinds:?}");
+            }
+        }
+    }
+
+    /// A mesh light's records are its triangles' vertices, face normals and error scales.
+    #[test]
+    fn light_triangle_records_are_the_mesh_triangles() {
+        let scene = Scene::build(load("cbox-meshlight/cbox-meshlight.xml")).unwrap();
+        let lanes = lane_setup(&scene, &mis()).expect("covered");
+        let mut checked = 0;
+        for light in &lanes.lights {
+            let LaneLight::Mesh { mesh, records, .. } = light else {
+                continue;
+            };
+            assert_eq!(records.len(), mesh.indices.len());
+            for (t, r) in records.iter().enumerate() {
+                assert_eq!(r.v, mesh.vertices(t));
+                assert_eq!((r.ng, r.err), mesh.face(t));
+                checked += 1;
+            }
+        }
+        assert!(checked > 2, "{checked} light triangles");
+    }
+}
