@@ -14,10 +14,10 @@ skips it), and that time per sample in absolute terms. Each number is the best o
 renders; the JIT variant's first, compiling render is timed apart and not counted. Mitsuba needs 2 or more threads (with 1, writing an EXR
 hangs), so there is no 1-thread row.
 
-With --directlab, each Mitsuba render is followed by a directlab render of the same scene, spp,
-size and thread count with the same estimator (`mis-power-e1b1-uni-area`, its render time from
+With --directlab, each Mitsuba render is paired with a directlab render of the same scene, spp,
+size and thread count with the same estimator, the two taking turns going first (`mis-power-e1b1-uni-area`, its render time from
 --stats), and both best-of-N numbers are reported, with the median over the N pairs of the
-ratio of a directlab render to the Mitsuba render before it (`ratio_paired_median`): on a
+ratio of a directlab render to the Mitsuba render paired with it (`ratio_paired_median`): on a
 shared VM whose speed drifts by tens of percent over minutes, only renders interleaved like
 this compare the two renderers fairly.
 """
@@ -152,12 +152,17 @@ def main():
             n = film.size()[0] * film.size()[1] * a.spp
             times, ours = [], []
             for k in range(a.repeat + (1 if variant.startswith("llvm") else 0)):
+                paired = a.directlab and (k > 0 or not variant.startswith("llvm"))
+                # The two renderers take turns going first, so that neither always runs
+                # right after the other.
+                if paired and k % 2 == 1:
+                    ours.append(directlab_speed(a, path, "res" in params))
                 t = time.perf_counter()
                 img = mi.render(scene, spp=a.spp)
                 dr.eval(img)
                 dr.sync_thread()
                 times.append(time.perf_counter() - t)
-                if a.directlab and (k > 0 or not variant.startswith("llvm")):
+                if paired and k % 2 == 0:
                     ours.append(directlab_speed(a, path, "res" in params))
             first = ""
             if variant.startswith("llvm"):
@@ -205,7 +210,7 @@ def main():
                 rows.append(
                     ("throughput_slowest", path, label, a.threads, 0, min(ours), "samples/s")
                 )
-                # Each directlab render against the Mitsuba render just before it: a drift of
+                # Each directlab render against the Mitsuba render beside it: a drift of
                 # the VM's speed over minutes moves both of a pair, so the median of the pairs'
                 # ratios is steadier than the ratio of the two bests.
                 ratios = [o / (n / t) for o, t in zip(ours, times)]
