@@ -15,8 +15,8 @@ renders; the JIT variant's first, compiling render is timed apart and not counte
 hangs), so there is no 1-thread row.
 
 With --directlab, each Mitsuba render is paired with a directlab render of the same scene, spp,
-size and thread count with the same estimator, the two taking turns going first (`mis-power-e1b1-uni-area`, its render time from
---stats), and both best-of-N numbers are reported, with the median over the N pairs of the
+size and thread count with the same estimator (`mis-power-e1b1-uni-area`, its render time from
+--stats), the two taking turns going first, and both best-of-N numbers are reported, with the median over the N pairs of the
 ratio of a directlab render to the Mitsuba render paired with it (`ratio_paired_median`): on a
 shared VM whose speed drifts by tens of percent over minutes, only renders interleaved like
 this compare the two renderers fairly.

@@ -86,9 +86,9 @@ pub(super) struct Lanes<'a> {
 /// otherwise None and `Direct` shades every sample with `li`.
 pub(super) fn lane_setup<'a>(scene: &'a Scene, s: &Strategy) -> Option<Lanes<'a>> {
     let lights = lane_lights(scene, s)?;
-    let shapes = (0..scene.shapes.len() as u32)
-        .map(|shape| {
-            let sh = &scene.shapes[shape as usize];
+    let shapes = (0u32..)
+        .zip(&scene.shapes)
+        .map(|(shape, sh)| {
             let mat = &scene.materials[sh.material as usize];
             let material = match &mat.kind {
                 _ if mat.two_sided => LaneMaterial::Other,
