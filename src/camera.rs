@@ -5,7 +5,7 @@
 //! with splatting, but every pixel is the plain mean of its own independent samples, so
 //! per-pixel variance and error are meaningful for the harness.
 
-use crate::geometry::{Ray, NO_SKIP};
+use crate::geometry::{Ray, RayPacket, NO_SKIP};
 use crate::rng::{Rng, RngLanes, LANES};
 use crate::scene::desc::{CameraDesc, FilmDesc, FilterDesc, FovAxis};
 use glam::{Mat4, Vec2, Vec3};
@@ -105,7 +105,7 @@ impl Camera {
     /// x*dx + y*dy + z*1, `length` is (x*x + y*y) + z*z), so every ray is bitwise the one
     /// `generate_ray` gives, computed eight at a time.
     #[inline]
-    pub fn generate_rays(&self, px: u32, py: u32, rng: &mut RngLanes) -> [Ray; LANES] {
+    pub fn generate_rays(&self, px: u32, py: u32, rng: &mut RngLanes) -> RayPacket {
         let (ox, oy) = match self.filter {
             FilterDesc::Box => (
                 rng.next_f32().map(|u| u - 0.5),
@@ -139,13 +139,14 @@ impl Camera {
             }
             len[i] = (d[0][i] * d[0][i] + d[1][i] * d[1][i] + d[2][i] * d[2][i]).sqrt();
         }
-        std::array::from_fn(|i| Ray {
-            o: self.origin,
-            d: Vec3::new(d[0][i] / len[i], d[1][i] / len[i], d[2][i] / len[i]),
-            tmin: self.near * len[i],
-            tmax: self.far * len[i],
-            skip: NO_SKIP,
-        })
+        let mut rays = RayPacket::splat(&Ray::new(self.origin, Vec3::Z));
+        for i in 0..LANES {
+            for (unit, d) in rays.d.iter_mut().zip(&d) {
+                unit[i] = d[i] / len[i];
+            }
+            (rays.tmin[i], rays.tmax[i]) = (self.near * len[i], self.far * len[i]);
+        }
+        rays
     }
 }
 
@@ -244,7 +245,8 @@ mod tests {
                 let key = Rng::pixel_key(11, py as u64 * 97 + px as u64);
                 let mut lanes = RngLanes::for_pixel_samples(key, s0);
                 let rays = c.generate_rays(px, py, &mut lanes);
-                for (i, r) in rays.iter().enumerate() {
+                for i in 0..LANES {
+                    let r = &rays.ray(i);
                     let mut one = Rng::for_pixel_sample(key, s0 + i as u64);
                     let want = c.generate_ray(px, py, &mut one);
                     let bits = |r: &Ray| {

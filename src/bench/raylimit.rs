@@ -16,7 +16,7 @@
 
 use crate::emitter::{EmitterSelection, EmitterSelector, LightSampling};
 use crate::geometry::shape::intersect_sphere;
-use crate::geometry::{Hit, Ray, ShapeKind};
+use crate::geometry::{Hit, Ray, RayPacket, ShapeKind};
 use crate::math::{Frame, Rgb};
 use crate::rng::{Rng, LANES};
 use crate::scene::Scene;
@@ -36,8 +36,8 @@ pub struct RayMix {
 #[derive(Clone, Copy)]
 pub struct Packets {
     /// Rays and active-lane masks.
-    pub camera: ([Ray; LANES], u32),
-    pub shadow: ([Ray; LANES], u32),
+    pub camera: (RayPacket, u32),
+    pub shadow: (RayPacket, u32),
     /// Per lane, its BSDF ray's index in `RayMix::bsdf`, or `NONE`.
     pub bsdf: [u32; LANES],
 }
@@ -47,21 +47,20 @@ pub const NONE: u32 = u32::MAX;
 
 #[cfg(test)]
 impl RayMix {
-    pub fn camera_rays(&self) -> impl Iterator<Item = &Ray> {
+    pub fn camera_rays(&self) -> impl Iterator<Item = Ray> + '_ {
         self.packets.iter().flat_map(|p| lanes(&p.camera))
     }
 
-    pub fn shadow_rays(&self) -> impl Iterator<Item = &Ray> {
+    pub fn shadow_rays(&self) -> impl Iterator<Item = Ray> + '_ {
         self.packets.iter().flat_map(|p| lanes(&p.shadow))
     }
 }
 
 /// The active rays of a packet.
-fn lanes((rays, mask): &([Ray; LANES], u32)) -> impl Iterator<Item = &Ray> {
-    rays.iter()
-        .enumerate()
-        .filter(move |(i, _)| mask >> i & 1 != 0)
-        .map(|(_, r)| r)
+fn lanes((rays, mask): &(RayPacket, u32)) -> impl Iterator<Item = Ray> + '_ {
+    (0..LANES)
+        .filter(move |i| mask >> i & 1 != 0)
+        .map(|i| rays.ray(i))
 }
 
 /// The ray mix of `spp` samples per pixel of the scene's camera, emitters chosen by `selection`.
@@ -74,7 +73,7 @@ pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
         n_camera: 0,
         n_shadow: 0,
     };
-    let empty = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z); LANES];
+    let empty = RayPacket::default();
     for y in 0..cam.height {
         for x in 0..cam.width {
             for s in 0..spp {
@@ -89,7 +88,8 @@ pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
                 let p = mix.packets.last_mut().expect("pushed above");
                 let mut rng = Rng::for_sample(7, (y * cam.width + x) as u64, s as u64);
                 let ray = cam.generate_ray(x, y, &mut rng);
-                (p.camera.0[lane], p.camera.1) = (ray, p.camera.1 | 1 << lane);
+                p.camera.0.set(lane, &ray);
+                p.camera.1 |= 1 << lane;
                 mix.n_camera += 1;
                 let Some(hit) = scene.intersect(&ray) else {
                     continue;
@@ -105,7 +105,7 @@ pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
                 }) {
                     let (f, _) = mat.eval_pdf(wi, frame.to_local(ls.wi));
                     if f != Rgb::ZERO && ls.li != Rgb::ZERO {
-                        p.shadow.0[lane] = scene.shadow_ray(&sp, &ls);
+                        p.shadow.0.set(lane, &scene.shadow_ray(&sp, &ls));
                         p.shadow.1 |= 1 << lane;
                         mix.n_shadow += 1;
                     }
@@ -408,13 +408,13 @@ pub fn measure_obvhs(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
             let w = warm.load(mix, chunk);
             let t = Instant::now();
             let camera = w.packets.iter().flat_map(|p| lanes(&p.camera));
-            for r in camera.chain(w.bsdf.iter().map(|b| &b.0)) {
+            for r in camera.chain(w.bsdf.iter().map(|b| b.0)) {
                 let mut hit = obvhs::ray::RayHit::none();
-                sink += bvh.ray_traverse(ray(r), &mut hit, prim) as usize;
+                sink += bvh.ray_traverse(ray(&r), &mut hit, prim) as usize;
             }
             let t1 = Instant::now();
             for r in w.packets.iter().flat_map(|p| lanes(&p.shadow)) {
-                sink += !bvh.ray_traverse_miss(ray(r), prim) as usize;
+                sink += !bvh.ray_traverse_miss(ray(&r), prim) as usize;
             }
             closest += (t1 - t).as_secs_f64();
             occl += t1.elapsed().as_secs_f64();
@@ -501,8 +501,8 @@ mod tests {
             for lane in 0..n {
                 let (x, y) = (pixel as u32 % cam.width, pixel as u32 / cam.width);
                 let mut rng = Rng::for_sample(7, pixel as u64, (s0 + lane as u32) as u64);
-                assert_eq!(p.camera.0[lane].d, cam.generate_ray(x, y, &mut rng).d);
-                let hit = scene.intersect(&p.camera.0[lane]).is_some();
+                assert_eq!(p.camera.0.d(lane), cam.generate_ray(x, y, &mut rng).d);
+                let hit = scene.intersect(&p.camera.0.ray(lane)).is_some();
                 assert_eq!(
                     p.shadow.1 >> lane & 1 != 0,
                     hit,
@@ -515,7 +515,10 @@ mod tests {
                 );
                 if hit {
                     let b = &mix.bsdf[p.bsdf[lane] as usize].0;
-                    assert!(p.shadow.0[lane].o.distance(b.o) < 1e-3, "same hit point");
+                    assert!(
+                        p.shadow.0.ray(lane).o.distance(b.o) < 1e-3,
+                        "same hit point"
+                    );
                 }
                 shadows += hit as usize;
                 bsdfs += hit as usize;
@@ -540,8 +543,8 @@ mod tests {
             let w = warm.load(&mix, chunk);
             for (p, q) in chunk.iter().zip(&w.packets) {
                 assert_eq!((p.camera.1, p.shadow.1), (q.camera.1, q.shadow.1));
-                assert_eq!(p.camera.0.map(|r| r.d), q.camera.0.map(|r| r.d));
-                assert_eq!(p.shadow.0.map(|r| r.o), q.shadow.0.map(|r| r.o));
+                assert_eq!(p.camera.0.d, q.camera.0.d);
+                assert_eq!(p.shadow.0.o, q.shadow.0.o);
                 for (&b, &c) in p.bsdf.iter().zip(&q.bsdf) {
                     assert_eq!(b == NONE, c == NONE);
                     if b != NONE {

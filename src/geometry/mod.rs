@@ -11,6 +11,7 @@ pub mod watertight;
 mod watertight8;
 
 pub use accel::Accel;
+pub use packet::RayPacket;
 pub use shape::{Mesh, Shape, ShapeKind, Sphere};
 
 use glam::Vec3;

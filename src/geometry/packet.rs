@@ -17,11 +17,68 @@ use super::lanes8::{F8, M8};
 use super::shape::intersect_sphere;
 use super::watertight8::{Lanes3, Rays8, WatertightRay8};
 use super::{Hit, Ray, Shape};
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use std::mem::MaybeUninit;
 
 /// Rays per packet.
 pub const PACKET: usize = 8;
+
+/// Up to eight rays, one array per component. Packets are traced in this form, and the lane
+/// kernel and the camera compute their rays in it, so no packet is transposed on the way.
+/// Lanes outside a query's active mask may hold anything (even NaN): no answer reads them.
+#[derive(Clone, Copy, Debug)]
+pub struct RayPacket {
+    pub o: [[f32; PACKET]; 3],
+    pub d: [[f32; PACKET]; 3],
+    pub tmin: [f32; PACKET],
+    pub tmax: [f32; PACKET],
+    pub skip: [u32; PACKET],
+}
+
+impl RayPacket {
+    /// Eight copies of a ray.
+    pub fn splat(r: &Ray) -> Self {
+        RayPacket {
+            o: r.o.to_array().map(|c| [c; PACKET]),
+            d: r.d.to_array().map(|c| [c; PACKET]),
+            tmin: [r.tmin; PACKET],
+            tmax: [r.tmax; PACKET],
+            skip: [r.skip; PACKET],
+        }
+    }
+
+    #[inline(always)]
+    pub fn ray(&self, i: usize) -> Ray {
+        Ray {
+            o: Vec3::new(self.o[0][i], self.o[1][i], self.o[2][i]),
+            d: self.d(i),
+            tmin: self.tmin[i],
+            tmax: self.tmax[i],
+            skip: self.skip[i],
+        }
+    }
+
+    /// Lane i's direction.
+    #[inline(always)]
+    pub fn d(&self, i: usize) -> Vec3 {
+        Vec3::new(self.d[0][i], self.d[1][i], self.d[2][i])
+    }
+
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, r: &Ray) {
+        for a in 0..3 {
+            (self.o[a][i], self.d[a][i]) = (r.o[a], r.d[a]);
+        }
+        (self.tmin[i], self.tmax[i], self.skip[i]) = (r.tmin, r.tmax, r.skip);
+    }
+}
+
+impl Default for RayPacket {
+    /// Eight copies of an unbounded ray along +z from the origin.
+    fn default() -> Self {
+        RayPacket::splat(&Ray::new(Vec3::ZERO, Vec3::Z))
+    }
+}
 
 /// Iterates the set bits of a mask, lowest first.
 #[inline(always)]
@@ -215,22 +272,9 @@ impl WideBvh {
     }
 }
 
-/// A packet's origins, directions (by axis) and tmins: transposed once, for both set-ups.
-#[inline(always)]
-fn by_axis(rays: &[Ray; PACKET]) -> (Lanes3, Lanes3, [f32; PACKET]) {
-    let (mut o, mut d, mut tmin) = ([[0.0; PACKET]; 3], [[0.0; PACKET]; 3], [0.0; PACKET]);
-    // Loops, not `array::map`: its closures were not inlined here.
-    for (i, r) in rays.iter().enumerate() {
-        (o[0][i], o[1][i], o[2][i]) = (r.o.x, r.o.y, r.o.z);
-        (d[0][i], d[1][i], d[2][i]) = (r.d.x, r.d.y, r.d.z);
-        tmin[i] = r.tmin;
-    }
-    (o, d, tmin)
-}
-
 /// A packet's per-ray set-up.
 struct Rays<'a> {
-    rays: &'a [Ray; PACKET],
+    rays: &'a RayPacket,
     boxes: Boxes,
     tests: Rays8,
     /// The packet's active rays, for the eight-ray triangle test.
@@ -239,12 +283,11 @@ struct Rays<'a> {
 
 impl<'a> Rays<'a> {
     #[inline(always)]
-    fn new(rays: &'a [Ray; PACKET], active: u32) -> Self {
-        let (o, d, tmin) = by_axis(rays);
+    fn new(rays: &'a RayPacket, active: u32) -> Self {
         Rays {
             rays,
-            boxes: Boxes::new(&o, &d, &tmin),
-            tests: Rays8::new(&o, &d),
+            boxes: Boxes::new(&rays.o, &rays.d, &rays.tmin),
+            tests: Rays8::new(&rays.o, &rays.d),
             active,
         }
     }
@@ -270,8 +313,8 @@ impl<'a> Rays<'a> {
     #[inline(always)]
     fn skipping(&self, id: u32) -> M8 {
         let mut m = 0;
-        for (i, r) in self.rays.iter().enumerate() {
-            m |= ((r.skip == id) as u32) << i;
+        for (i, &skip) in self.rays.skip.iter().enumerate() {
+            m |= ((skip == id) as u32) << i;
         }
         M8::from_bits(m)
     }
@@ -281,20 +324,20 @@ impl Accel {
     /// `intersect` for each ray set in `active`, traced as one packet.
     pub fn intersect8(
         &self,
-        rays: &[Ray; PACKET],
+        rays: &RayPacket,
         active: u32,
         shapes: &[Shape],
     ) -> [Option<Hit>; PACKET] {
         let mut out = [None; PACKET];
         if active.count_ones() <= 1 {
             for i in bits(active) {
-                out[i] = self.intersect(&rays[i], shapes);
+                out[i] = self.intersect(&rays.ray(i), shapes);
             }
             return out;
         }
         let r = Rays::new(rays, active);
         let tmin8 = r.tmin8();
-        let mut tmax = rays.map(|r| r.tmax);
+        let mut tmax = rays.tmax;
         // Per ray, the best primitive and its barycentrics.
         let mut best = [(u32::MAX, Vec2::ZERO); PACKET];
         self.bvh
@@ -330,11 +373,11 @@ impl Accel {
                         }
                     } else {
                         for i in bits(mask) {
-                            let skip = leaf.skip(r.rays[i].skip);
+                            let skip = leaf.skip(r.rays.skip[i]);
                             if let Some((lane, t, b1, b2)) =
                                 r.tests
                                     .ray(i)
-                                    .closest(&leaf.tris, r.rays[i].tmin, tmax[i], skip)
+                                    .closest(&leaf.tris, r.rays.tmin[i], tmax[i], skip)
                             {
                                 tmax[i] = t;
                                 best[i] = (leaf.tri_ref[lane], Vec2::new(b1, b2));
@@ -345,7 +388,7 @@ impl Accel {
                 for &(c, rad, id) in &self.spheres[leaf.spheres.0 as usize..leaf.spheres.1 as usize]
                 {
                     for i in bits(mask) {
-                        let Ray { o, d, tmin, .. } = r.rays[i];
+                        let Ray { o, d, tmin, .. } = r.rays.ray(i);
                         if let Some(t) = intersect_sphere(o, d, tmin, tmax[i], c, rad) {
                             tmax[i] = t;
                             best[i] = (id, Vec2::ZERO);
@@ -355,7 +398,7 @@ impl Accel {
             });
         for i in bits(active) {
             // As `closest`: a hit only if it shortened the ray.
-            if best[i].0 == u32::MAX || !(tmax[i] < rays[i].tmax) {
+            if best[i].0 == u32::MAX || !(tmax[i] < rays.tmax[i]) {
                 continue;
             }
             let t = tmax[i];
@@ -363,7 +406,7 @@ impl Accel {
                 shapes,
                 self.refs[best[i].0 as usize],
                 best[i].1,
-                &rays[i],
+                &rays.ray(i),
                 t,
             );
             out[i] = Some(Hit { t, sp });
@@ -372,14 +415,14 @@ impl Accel {
     }
 
     /// `occluded` for each ray set in `active`, traced as one packet: the mask of those blocked.
-    pub fn occluded8(&self, rays: &[Ray; PACKET], active: u32) -> u32 {
+    pub fn occluded8(&self, rays: &RayPacket, active: u32) -> u32 {
         if active.count_ones() <= 1 {
             return bits(active)
-                .filter(|&i| self.occluded(&rays[i]))
+                .filter(|&i| self.occluded(&rays.ray(i)))
                 .fold(0, |m, i| m | 1 << i);
         }
         let r = Rays::new(rays, active);
-        let tmax = rays.map(|r| r.tmax);
+        let tmax = rays.tmax;
         let (tmin8, tmax8) = (r.tmin8(), F8::load(&tmax));
         self.bvh.any8(&r.boxes, active, &tmax, |l, mask| {
             let leaf = &self.leaves[l];
@@ -396,10 +439,10 @@ impl Accel {
                     }
                 } else {
                     for i in bits(mask) {
-                        let skip = leaf.skip(r.rays[i].skip);
+                        let skip = leaf.skip(r.rays.skip[i]);
                         if r.tests
                             .ray(i)
-                            .any(&leaf.tris, r.rays[i].tmin, tmax[i], skip)
+                            .any(&leaf.tris, r.rays.tmin[i], tmax[i], skip)
                         {
                             blocked |= 1 << i;
                         }
@@ -408,7 +451,7 @@ impl Accel {
             }
             for &(c, rad, _) in &self.spheres[leaf.spheres.0 as usize..leaf.spheres.1 as usize] {
                 for i in bits(mask & !blocked) {
-                    let Ray { o, d, tmin, .. } = r.rays[i];
+                    let Ray { o, d, tmin, .. } = r.rays.ray(i);
                     if intersect_sphere(o, d, tmin, tmax[i], c, rad).is_some() {
                         blocked |= 1 << i;
                     }
@@ -425,10 +468,29 @@ mod tests {
     use crate::rng::Rng;
     use glam::Vec3;
 
-    /// Up to eight rays as a packet and its active mask.
-    fn packet_of(rays: &[Ray]) -> ([Ray; PACKET], u32) {
-        let mut out = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
-        out[..rays.len()].copy_from_slice(rays);
+    /// Up to eight rays as a packet and its active mask. The other lanes, which no answer
+    /// may read, hold by turns a NaN ray and the first ray reversed and unbounded (it hits
+    /// what lies behind), both skipping primitive 0.
+    fn packet_of(rays: &[Ray]) -> (RayPacket, u32) {
+        let nan = Vec3::splat(f32::NAN);
+        let nan_ray = Ray {
+            tmin: f32::NAN,
+            tmax: f32::NAN,
+            skip: 0,
+            ..Ray::new(nan, nan)
+        };
+        let back = Ray {
+            skip: 0,
+            ..Ray::new(rays[0].o, -rays[0].d)
+        };
+        let mut out = RayPacket::splat(&nan_ray);
+        for i in 0..PACKET {
+            out.set(
+                i,
+                rays.get(i)
+                    .unwrap_or(if i % 2 == 0 { &nan_ray } else { &back }),
+            );
+        }
         (out, (1u32 << rays.len()) - 1)
     }
 
@@ -459,8 +521,8 @@ mod tests {
                     ..Ray::new(o, Vec3::from_array(c))
                 }
             });
-            let (o, d, tmin) = by_axis(&rays);
-            let b = Boxes::new(&o, &d, &tmin);
+            let (packet, _) = packet_of(&rays);
+            let b = Boxes::new(&packet.o, &packet.d, &packet.tmin);
             for (i, r) in rays.iter().enumerate() {
                 let inv = slab_inv(r.d).to_array().map(f32::to_bits);
                 assert_eq!([0, 1, 2].map(|a| b.inv[a][i].to_bits()), inv, "{:?}", r.d);

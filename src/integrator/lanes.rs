@@ -1,10 +1,10 @@
 //! The direct estimator for eight camera samples of a pixel at once, in vector lanes.
 //!
-//! The camera rays and the shadow rays of the eight samples are traced as packets (see
-//! `geometry::packet`), the BSDF rays one at a time. Everything between them (shading frames,
-//! light points, densities, BSDF values, MIS weights, the shadow and BSDF rays) runs as loops
-//! over the eight samples, in structure-of-arrays form, which the compiler turns into vector
-//! code.
+//! The camera rays and the shadow rays of the eight samples are made and traced as packets,
+//! one array per component (`RayPacket`, see `geometry::packet`), the BSDF rays one at a
+//! time. Everything between them (shading frames, light points, densities, BSDF values, MIS
+//! weights, the shadow and BSDF rays) runs as loops over the eight samples, in
+//! structure-of-arrays form, which the compiler turns into vector code.
 //! Each loop body calls the same scalar functions as `Direct::li`, in the same order, so every
 //! sample is bitwise what `li` gives it (`render` tests this on the bundled scenes).
 //!
@@ -22,7 +22,7 @@ use super::direct::{heuristic, Direct};
 use super::lane_tables::{LaneLight, LaneMaterial, LaneShape};
 use crate::bsdf::{BsdfSample, Diffuse};
 use crate::emitter::{area_pdf_along, sample_at, sphere_area_point};
-use crate::geometry::{Accel, Mesh, Ray, Sphere, SurfacePoint};
+use crate::geometry::{Accel, Mesh, Ray, RayPacket, Sphere, SurfacePoint};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
 use crate::sampling::warps::square_to_uniform_triangle;
@@ -49,6 +49,17 @@ impl V3x8 {
     #[inline(always)]
     pub(super) fn set(&mut self, i: usize, v: Vec3) {
         (self.x[i], self.y[i], self.z[i]) = (v.x, v.y, v.z);
+    }
+
+    /// The components as a ray packet holds them.
+    #[inline(always)]
+    pub(super) fn axes(&self) -> [[f32; LANES]; 3] {
+        [self.x, self.y, self.z]
+    }
+
+    #[inline(always)]
+    fn from_axes([x, y, z]: [[f32; LANES]; 3]) -> Self {
+        V3x8 { x, y, z }
     }
 }
 
@@ -119,10 +130,10 @@ pub(super) struct Shaded {
 impl Direct<'_> {
     /// `li` of the first `n` rays, each with its lane of `rng` (which must stand where `li`
     /// would receive it): in lanes where they cover the scene and strategy, else one by one.
-    pub fn li_lanes(&self, rays: &[Ray; LANES], n: usize, rng: &mut RngLanes) -> [Rgb; LANES] {
+    pub fn li_lanes(&self, rays: &RayPacket, n: usize, rng: &mut RngLanes) -> [Rgb; LANES] {
         let Some(lanes) = &self.lanes else {
             return std::array::from_fn(|i| match i < n {
-                true => self.li(&rays[i], &mut rng.lane(i)),
+                true => self.li(&rays.ray(i), &mut rng.lane(i)),
                 false => Rgb::ZERO,
             });
         };
@@ -153,13 +164,16 @@ impl Direct<'_> {
     fn camera_hits(
         &self,
         shapes: &[LaneShape],
-        rays: &[Ray; LANES],
+        rays: &RayPacket,
         n: usize,
         rng: &RngLanes,
         out: &mut [Rgb; LANES],
     ) -> CameraHits {
         let scene = self.scene;
-        let mut h = CameraHits::default();
+        let mut h = CameraHits {
+            d: V3x8::from_axes(rays.d),
+            ..CameraHits::default()
+        };
         let mut batch = None;
         let camera = scene.intersect8(rays, (1 << n) - 1);
         for i in 0..n {
@@ -188,13 +202,13 @@ impl Direct<'_> {
                 LaneMaterial::Other => None,
             };
             if rough.is_none_or(|r| r != *batch.get_or_insert(r)) {
-                out[i] = self.li_hit(&rays[i], &sp, &mut rng.lane(i));
+                out[i] = self.li_hit(&rays.ray(i), &sp, &mut rng.lane(i));
                 continue;
             }
             let mut l = Rgb::ZERO;
             if !self.strategy.hide_emitters {
                 if let Some(e) = shape.emitter {
-                    l += scene.emitters[e as usize].le(&sp, -rays[i].d);
+                    l += scene.emitters[e as usize].le(&sp, -rays.d(i));
                 }
             }
             h.l[i] = Some(l);
@@ -202,7 +216,6 @@ impl Direct<'_> {
             h.ng.set(i, sp.ng);
             h.ns.set(i, sp.ns);
             h.err.set(i, sp.err_scale);
-            h.d.set(i, rays[i].d);
             h.skip[i] = Accel::skip_from(shape.skip_base, sp.prim);
             h.emitter_skip[i] = Accel::skip_from(shape.emitter_skip_base, sp.prim);
         }
@@ -344,14 +357,12 @@ impl Direct<'_> {
         let s = &self.strategy;
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
         let bsdf_w = |pb, pl| heuristic(s.heuristic, nb * pb, ne * pl);
-        let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); LANES];
+        // Every lane's ray is computed; only those of covered lanes with a light sample
+        // are traced.
+        let shadow = Scene::shadow_rays_to(&sh.shadow_o.axes(), &sh.shadow_target.axes(), &h.skip);
         let mut traced = 0u32;
         for i in 0..LANES {
-            if h.l[i].is_some() && sh.light_ok[i] {
-                shadow[i] =
-                    Scene::shadow_ray_to(sh.shadow_o.get(i), sh.shadow_target.get(i), h.skip[i]);
-                traced |= 1 << i;
-            }
+            traced |= ((h.l[i].is_some() && sh.light_ok[i]) as u32) << i;
         }
         let blocked = scene.accel.occluded8(&shadow, traced);
         for i in 0..LANES {

@@ -199,7 +199,7 @@ impl VisibleX8 {
 #[cfg(test)]
 mod tests {
     use crate::bsdf::BsdfKind;
-    use crate::geometry::Ray;
+    use crate::geometry::{Ray, RayPacket};
     use crate::integrator::{Direct, Strategy};
     use crate::rng::{Rng, RngLanes, LANES};
     use crate::sampling::microfacet::ITERS;
@@ -233,7 +233,8 @@ mod tests {
             .expect("a ray onto a plate");
         let away = Ray::new(plate.o, Vec3::Y);
         assert!(scene.intersect(&away).is_none());
-        let rays: [Ray; LANES] = std::array::from_fn(|i| if i < 4 { plate } else { away });
+        let mut rays = RayPacket::splat(&away);
+        (0..4).for_each(|i| rays.set(i, &plate));
         let batches = 64;
         ITERS.with(|c| c.set(0));
         for b in 0..batches {

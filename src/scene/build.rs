@@ -8,7 +8,9 @@ use crate::bsdf::{
 use crate::camera::Camera;
 use crate::emitter::{AreaLight, Emitter, LightSample, PointLight};
 use crate::geometry::packet::PACKET;
-use crate::geometry::{Accel, Hit, Mesh, Ray, Shape, ShapeKind, Sphere, SurfacePoint, NO_SKIP};
+use crate::geometry::{
+    Accel, Hit, Mesh, Ray, RayPacket, Shape, ShapeKind, Sphere, SurfacePoint, NO_SKIP,
+};
 use crate::math::{offset_origin, Rgb};
 use crate::sampling::microfacet::Microfacet;
 use crate::sampling::AliasTable;
@@ -176,6 +178,9 @@ fn check_positive(origin: &str, what: &str, x: f32) -> Result<(), BuildError> {
     Ok(())
 }
 
+/// Where a shadow ray from an origin to a target (at t = 1) stops: just short of the target.
+const SHADOW_TMAX: f32 = 1.0 - 1e-4;
+
 impl Scene {
     pub fn build(desc: SceneDesc) -> Result<Scene, BuildError> {
         let mut shapes = Vec::new();
@@ -310,7 +315,7 @@ impl Scene {
 
     /// `intersect` of each ray set in `active`, traced as one packet.
     #[inline]
-    pub fn intersect8(&self, rays: &[Ray; PACKET], active: u32) -> [Option<Hit>; PACKET] {
+    pub fn intersect8(&self, rays: &RayPacket, active: u32) -> [Option<Hit>; PACKET] {
         self.accel.intersect8(rays, active, &self.shapes)
     }
 
@@ -397,8 +402,30 @@ impl Scene {
             o,
             d: target - o,
             tmin: 0.0,
-            tmax: 1.0 - 1e-4,
+            tmax: SHADOW_TMAX,
             skip,
+        }
+    }
+
+    /// `shadow_ray_to` in each lane, from origins and targets given one array per axis.
+    #[inline(always)]
+    pub fn shadow_rays_to(
+        o: &[[f32; PACKET]; 3],
+        target: &[[f32; PACKET]; 3],
+        skip: &[u32; PACKET],
+    ) -> RayPacket {
+        let mut d = [[0.0; PACKET]; 3];
+        for a in 0..3 {
+            for i in 0..PACKET {
+                d[a][i] = target[a][i] - o[a][i];
+            }
+        }
+        RayPacket {
+            o: *o,
+            d,
+            tmin: [0.0; PACKET],
+            tmax: [SHADOW_TMAX; PACKET],
+            skip: *skip,
         }
     }
 
