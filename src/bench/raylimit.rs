@@ -9,7 +9,8 @@
 //! surface's horizon, outside a narrow lobe) and no BSDF ray where the material draws none:
 //! rays the renderer never traces would count as traversal it does not do. The camera rays
 //! and the shadow rays of each pixel's groups of `LANES` samples are traced as packets, as
-//! the renderer traces them (`Scene::intersect8`, `Accel::occluded8`); BSDF rays one by one.
+//! the renderer traces them (`Scene::intersect8`, `Accel::occluded8`); BSDF rays one by one
+//! past a box reject of the group's rays in lanes (`bsdf_queries`).
 //! Every timing traces the mix a chunk of 64 groups at a time, each chunk copied into cache
 //! first and untimed (`Warm`): the renderer makes its rays in registers, not in a stream of
 //! tens of MB from memory.
@@ -196,8 +197,8 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
                 sink += prim(scene.intersect(r));
             }
             let t2 = Instant::now();
-            for (r, skip) in &w.bsdf {
-                sink += prim(scene.bsdf_ray_hit(r, *skip));
+            for b in &w.bsdf_packets {
+                sink += bsdf_queries(scene, b);
             }
             let t3 = Instant::now();
             for p in &w.packets {
@@ -268,6 +269,25 @@ struct Warm {
     packets: Vec<Packets>,
     /// The chunk's BSDF rays; the copied packets' `bsdf` indices point here.
     bsdf: Vec<(Ray, u32)>,
+    /// Per packet, its BSDF rays as the renderer holds them (see `bsdf_queries`).
+    bsdf_packets: Vec<BsdfPacket>,
+}
+
+/// A group's BSDF rays in lanes, each lane's emitter skip id, and the mask of lanes with one.
+type BsdfPacket = (RayPacket, [u32; LANES], u32);
+
+/// The renderer's emitter queries of a group's BSDF rays: `Scene::bsdf_rays_may_hit` in
+/// lanes, then `bsdf_ray_hit_traced` of each ray it lets through.
+#[inline(always)]
+fn bsdf_queries(scene: &Scene, (rays, skips, active): &BsdfPacket) -> usize {
+    let mut sink = 0;
+    let mut may = scene.bsdf_rays_may_hit(rays, *active);
+    while may != 0 {
+        let i = may.trailing_zeros() as usize;
+        may &= may - 1;
+        sink += prim(scene.bsdf_ray_hit_traced(&rays.ray(i), skips[i]));
+    }
+    sink
 }
 
 impl Warm {
@@ -287,12 +307,22 @@ impl Warm {
         }));
         self.bsdf.clear();
         self.bsdf.extend_from_slice(&mix.bsdf[lo..hi]);
+        self.bsdf_packets.clear();
+        for p in &self.packets {
+            let mut b: BsdfPacket = (RayPacket::default(), [0; LANES], 0);
+            for (i, &k) in p.bsdf.iter().enumerate().filter(|(_, &k)| k != NONE) {
+                let (ray, skip) = &self.bsdf[k as usize];
+                b.0.set(i, ray);
+                (b.1[i], b.2) = (*skip, b.2 | 1 << i);
+            }
+            self.bsdf_packets.push(b);
+        }
         self
     }
 }
 
 /// The groups in the renderer's order, chunk by warm chunk: each group's camera packet, its
-/// shadow packet, then its BSDF rays one by one, as the renderer's queries. Returns a
+/// shadow packet, then its BSDF rays, as the renderer's queries. Returns a
 /// checksum of the answers and the seconds spent tracing.
 fn trace_in_order<'a>(
     scene: &Scene,
@@ -304,13 +334,10 @@ fn trace_in_order<'a>(
     for chunk in chunks {
         let w = warm.load(mix, chunk);
         let t = Instant::now();
-        for p in &w.packets {
+        for (p, b) in w.packets.iter().zip(&w.bsdf_packets) {
             sink += packet_prims(scene.intersect8(&p.camera.0, p.camera.1));
             sink += scene.accel.occluded8(&p.shadow.0, p.shadow.1) as usize;
-            for &b in p.bsdf.iter().filter(|&&b| b != NONE) {
-                let (r, skip) = &w.bsdf[b as usize];
-                sink += prim(scene.bsdf_ray_hit(r, *skip));
-            }
+            sink += bsdf_queries(scene, b);
         }
         seconds += t.elapsed().as_secs_f64();
     }
@@ -541,14 +568,23 @@ mod tests {
         let mut all = Vec::new();
         for chunk in mix.packets.chunks(3) {
             let w = warm.load(&mix, chunk);
-            for (p, q) in chunk.iter().zip(&w.packets) {
+            assert_eq!(w.bsdf_packets.len(), chunk.len());
+            for ((p, q), lanes) in chunk.iter().zip(&w.packets).zip(&w.bsdf_packets) {
                 assert_eq!((p.camera.1, p.shadow.1), (q.camera.1, q.shadow.1));
                 assert_eq!(p.camera.0.d, q.camera.0.d);
                 assert_eq!(p.shadow.0.o, q.shadow.0.o);
-                for (&b, &c) in p.bsdf.iter().zip(&q.bsdf) {
+                for (i, (&b, &c)) in p.bsdf.iter().zip(&q.bsdf).enumerate() {
                     assert_eq!(b == NONE, c == NONE);
+                    assert_eq!(
+                        lanes.2 >> i & 1 == 0,
+                        b == NONE,
+                        "lane {i} of the BSDF packet"
+                    );
                     if b != NONE {
-                        assert_eq!(mix.bsdf[b as usize].0.d, w.bsdf[c as usize].0.d);
+                        let (ray, skip) = mix.bsdf[b as usize];
+                        assert_eq!(ray.d, w.bsdf[c as usize].0.d);
+                        assert_eq!((lanes.0.ray(i).o, lanes.0.ray(i).d), (ray.o, ray.d));
+                        assert_eq!((lanes.0.skip[i], lanes.1[i]), (ray.skip, skip));
                     }
                 }
             }

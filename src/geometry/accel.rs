@@ -5,7 +5,7 @@ use super::bvh::WideBvh;
 use super::shape::{intersect_sphere, Shape, ShapeKind};
 use super::sphere8::Spheres8;
 use super::watertight::{Tri4, WatertightRay};
-use super::{Hit, Ray, SurfacePoint, NO_SKIP};
+use super::{Hit, Ray, RayPacket, SurfacePoint, NO_SKIP};
 use glam::{BVec4A, Vec2, Vec3, Vec3A};
 use obvhs::{aabb::Aabb, bvh2::builder::build_bvh2, BvhBuildParams};
 use std::time::Duration;
@@ -260,6 +260,13 @@ impl Accel {
     #[inline(always)]
     pub fn may_hit(&self, ray: &Ray) -> bool {
         self.bvh.may_enter(ray.o, ray.d, ray.tmin, ray.tmax)
+    }
+
+    /// `may_hit` of each ray of a packet: bit i is lane i's answer.
+    #[inline(always)]
+    pub fn may_hit8(&self, rays: &RayPacket) -> u32 {
+        self.bvh
+            .may_enter8(&rays.o, &rays.d, &rays.tmin, &rays.tmax)
     }
 
     /// True if anything blocks the ray within its interval.

@@ -187,6 +187,32 @@ impl WideBvh {
         tn <= tf * ROBUST
     }
 
+    /// `may_enter` of eight rays, given one array per component, in lanes: bit i is lane
+    /// i's answer. The same IEEE operations per lane (min and max may differ from the scalar
+    /// order only in the sign of a zero, which `<=` does not see).
+    #[inline(always)]
+    pub fn may_enter8(
+        &self,
+        o: &[[f32; 8]; 3],
+        d: &[[f32; 8]; 3],
+        tmin: &[f32; 8],
+        tmax: &[f32; 8],
+    ) -> u32 {
+        let (mut tn, mut tf) = (F8::load(tmin), F8::load(tmax));
+        for a in 0..3 {
+            let inv = F8::splat(1.0)
+                .div(F8::load(&d[a]))
+                .max(F8::splat(-f32::MAX))
+                .min(F8::splat(f32::MAX));
+            let o = F8::load(&o[a]);
+            let t0 = F8::splat(self.bounds.0[a]).sub(o).mul(inv);
+            let t1 = F8::splat(self.bounds.1[a]).sub(o).mul(inv);
+            tn = tn.max(t0.min(t1));
+            tf = tf.min(t0.max(t1));
+        }
+        tn.le_mask(tf.mul(F8::splat(ROBUST)))
+    }
+
     /// Appends the wide node standing for binary node `i` (or, for the root leaf, a node
     /// holding it) and returns the depth of the subtree in wide nodes.
     fn collapse(&mut self, bvh: &Bvh2, i: usize, root: bool) -> usize {
@@ -532,6 +558,10 @@ mod tests {
         let (lo, hi) = (Vec3::from(bvh.bounds.0), Vec3::from(bvh.bounds.1));
         let mut rng = crate::rng::Rng::new(5, 9);
         let (mut entered, mut rejected) = (0, 0);
+        // Every eighth ray, the eight rays so far in lanes, for `may_enter8`.
+        let (mut o8, mut d8, mut tmin8, mut tmax8) =
+            ([[0.0; 8]; 3], [[0.0; 8]; 3], [0.0; 8], [0.0; 8]);
+        let mut want8 = 0u32;
         for k in 0..20_000 {
             let o = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 12.0 - 1.0;
             // Aim at the box, with coordinates snapped to its faces on some axes.
@@ -550,6 +580,16 @@ mod tests {
             let any = bvh.any(o, d, tmin, tmax, |_, _| true);
             let may = bvh.may_enter(o, d, tmin, tmax);
             assert!(may || !any, "ray {k} enters a leaf but was rejected");
+            let lane = k % 8;
+            for a in 0..3 {
+                (o8[a][lane], d8[a][lane]) = (o[a], d[a]);
+            }
+            (tmin8[lane], tmax8[lane]) = (tmin, tmax);
+            want8 = want8 & !(1 << lane) | (may as u32) << lane;
+            if lane == 7 {
+                let got = bvh.may_enter8(&o8, &d8, &tmin8, &tmax8);
+                assert_eq!(got, want8, "rays {} to {k} in lanes", k - 7);
+            }
             entered += any as u32;
             rejected += !may as u32;
         }

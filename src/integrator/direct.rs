@@ -13,7 +13,7 @@ use super::lane_tables::{lane_setup, Lanes};
 use super::Strategy;
 use crate::bsdf::{BsdfSample, Material};
 use crate::emitter::{EmitterSelector, LightSample};
-use crate::geometry::{Ray, SurfacePoint};
+use crate::geometry::{Hit, Ray, SurfacePoint};
 use crate::math::{Frame, Rgb};
 use crate::rng::Rng;
 use crate::scene::desc::{Heuristic, StrategyKind};
@@ -252,11 +252,23 @@ impl<'a> Direct<'a> {
         bs: &BsdfSample,
         weight: impl Fn(f32, f32) -> f32,
     ) -> Rgb {
+        match self.scene.bsdf_ray_hit(ray, emitter_skip) {
+            Some(hit) => self.bsdf_emission(from, ray.d, &hit, bs, weight),
+            None => Rgb::ZERO,
+        }
+    }
+
+    /// `bsdf_arrive` once its ray (from `from`, direction `d`) has hit `hit`.
+    #[inline(always)]
+    pub(super) fn bsdf_emission(
+        &self,
+        from: Vec3,
+        d: Vec3,
+        hit: &Hit,
+        bs: &BsdfSample,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
         let scene = self.scene;
-        let d = ray.d;
-        let Some(hit) = scene.bsdf_ray_hit(ray, emitter_skip) else {
-            return Rgb::ZERO;
-        };
         let Some((ei, e)) = scene.emitter_at(&hit.sp) else {
             return Rgb::ZERO;
         };

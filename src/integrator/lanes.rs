@@ -22,7 +22,7 @@ use super::direct::{heuristic, Direct};
 use super::lane_tables::{LaneLight, LaneMaterial, LaneShape};
 use crate::bsdf::{BsdfSample, Diffuse};
 use crate::emitter::{area_pdf_along, sample_at, sphere_area_point};
-use crate::geometry::{Accel, Mesh, Ray, RayPacket, Sphere, SurfacePoint};
+use crate::geometry::{Accel, Mesh, RayPacket, Sphere, SurfacePoint};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
 use crate::sampling::warps::square_to_uniform_triangle;
@@ -365,31 +365,43 @@ impl Direct<'_> {
             traced |= ((h.l[i].is_some() && sh.light_ok[i]) as u32) << i;
         }
         let blocked = scene.accel.occluded8(&shadow, traced);
+        // The BSDF rays, put through `bsdf_ray_hit`'s box reject in lanes: only those it lets
+        // through are traced, one by one.
+        let bsdf_rays = RayPacket {
+            o: sh.bsdf_o.axes(),
+            d: sh.bsdf_d.axes(),
+            tmin: [0.0; LANES],
+            tmax: [f32::INFINITY; LANES],
+            skip: h.skip,
+        };
+        let mut open = 0u32;
         for i in 0..LANES {
-            let Some(mut l) = h.l[i] else {
-                continue;
-            };
-            let mut light = Rgb::ZERO;
-            if traced >> i & 1 != 0 && blocked >> i & 1 == 0 {
-                light = sh.light.get(i);
-            }
-            l += light / ne;
-            let mut bsdf = Rgb::ZERO;
-            if sh.bsdf_ok[i] {
-                let d = sh.bsdf_d.get(i);
-                let ray = Ray {
-                    skip: h.skip[i],
-                    ..Ray::new(sh.bsdf_o.get(i), d)
-                };
+            open |= ((h.l[i].is_some() && sh.bsdf_ok[i]) as u32) << i;
+        }
+        let mut bsdf = V3x8::default();
+        let mut may = scene.bsdf_rays_may_hit(&bsdf_rays, open);
+        while may != 0 {
+            let i = may.trailing_zeros() as usize;
+            may &= may - 1;
+            let ray = bsdf_rays.ray(i);
+            if let Some(hit) = scene.bsdf_ray_hit_traced(&ray, h.emitter_skip[i]) {
                 let bs = BsdfSample {
                     wo: Vec3::ZERO,
                     weight: sh.bsdf_weight.get(i),
                     pdf: sh.bsdf_pdf[i],
                     delta: false,
                 };
-                bsdf = self.bsdf_arrive(h.p.get(i), &ray, h.emitter_skip[i], &bs, bsdf_w);
+                bsdf.set(i, self.bsdf_emission(h.p.get(i), ray.d, &hit, &bs, bsdf_w));
             }
-            l += bsdf / nb;
+        }
+        for i in 0..LANES {
+            let Some(mut l) = h.l[i] else {
+                continue;
+            };
+            let lit = traced >> i & 1 != 0 && blocked >> i & 1 == 0;
+            let light = if lit { sh.light.get(i) } else { Rgb::ZERO };
+            l += light / ne;
+            l += bsdf.get(i) / nb;
             out[i] = l;
         }
     }

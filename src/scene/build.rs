@@ -352,9 +352,19 @@ impl Scene {
         }
     }
 
+    /// `bsdf_ray_hit`'s box reject of each ray set in `active`, in lanes: the mask of those
+    /// it lets through, whose answer is then `bsdf_ray_hit_traced`'s.
+    #[inline(always)]
+    pub fn bsdf_rays_may_hit(&self, rays: &RayPacket, active: u32) -> u32 {
+        match &self.emitter_accel {
+            Some(e) => e.may_hit8(rays) & active,
+            None => active,
+        }
+    }
+
     /// `bsdf_ray_hit` past the box reject: out of line, since few BSDF rays get here.
     #[inline(never)]
-    fn bsdf_ray_hit_traced(&self, ray: &Ray, emitter_skip: u32) -> Option<Hit> {
+    pub fn bsdf_ray_hit_traced(&self, ray: &Ray, emitter_skip: u32) -> Option<Hit> {
         if let Some(e) = &self.emitter_accel {
             if !e.occluded(&Ray {
                 skip: emitter_skip,
