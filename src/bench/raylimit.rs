@@ -17,7 +17,7 @@
 
 use crate::emitter::{EmitterSelection, EmitterSelector, LightSampling};
 use crate::geometry::shape::intersect_sphere;
-use crate::geometry::{Hit, Ray, RayPacket, ShapeKind};
+use crate::geometry::{Hit, PacketHits, Ray, RayPacket, ShapeKind};
 use crate::math::{Frame, Rgb};
 use crate::rng::{Rng, LANES};
 use crate::scene::Scene;
@@ -249,8 +249,8 @@ fn prim(h: Option<Hit>) -> usize {
     h.map_or(0, |h| h.sp.prim as usize & 1)
 }
 
-fn packet_prims(h: [Option<Hit>; LANES]) -> usize {
-    h.into_iter().map(prim).sum()
+fn packet_prims(h: PacketHits) -> usize {
+    (0..LANES).map(|i| prim(h.get(i))).sum()
 }
 
 /// Groups per warm chunk: their rays (about 70 kB) fit a core's L2 cache (512 kB on the

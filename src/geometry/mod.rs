@@ -4,6 +4,7 @@ pub mod accel;
 mod bvh;
 mod lanes8;
 pub mod packet;
+mod ray_packet;
 mod refine;
 pub mod shape;
 mod sphere8;
@@ -11,7 +12,7 @@ pub mod watertight;
 mod watertight8;
 
 pub use accel::Accel;
-pub use packet::RayPacket;
+pub use ray_packet::{PacketHits, RayPacket};
 pub use shape::{Mesh, Shape, ShapeKind, Sphere};
 
 use glam::Vec3;

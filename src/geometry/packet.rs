@@ -14,71 +14,16 @@ use super::accel::{surface_point, Accel};
 use super::bvh::{push_by_distance, read, slab_test, Node, WideBvh};
 use super::bvh::{LEAF, ROBUST, STACK};
 use super::lanes8::{F8, M8};
+use super::ray_packet::{PacketHits, RayPacket};
 use super::shape::intersect_sphere;
+use super::shape::ShapeKind;
 use super::watertight8::{Lanes3, Rays8, WatertightRay8};
-use super::{Hit, Ray, Shape};
-use glam::{Vec2, Vec3};
+use super::{Ray, Shape};
+use glam::Vec2;
 use std::mem::MaybeUninit;
 
 /// Rays per packet.
 pub const PACKET: usize = 8;
-
-/// Up to eight rays, one array per component. Packets are traced in this form, and the lane
-/// kernel and the camera compute their rays in it, so no packet is transposed on the way.
-/// Lanes outside a query's active mask may hold anything (even NaN): no answer reads them.
-#[derive(Clone, Copy, Debug)]
-pub struct RayPacket {
-    pub o: [[f32; PACKET]; 3],
-    pub d: [[f32; PACKET]; 3],
-    pub tmin: [f32; PACKET],
-    pub tmax: [f32; PACKET],
-    pub skip: [u32; PACKET],
-}
-
-impl RayPacket {
-    /// Eight copies of a ray.
-    pub fn splat(r: &Ray) -> Self {
-        RayPacket {
-            o: r.o.to_array().map(|c| [c; PACKET]),
-            d: r.d.to_array().map(|c| [c; PACKET]),
-            tmin: [r.tmin; PACKET],
-            tmax: [r.tmax; PACKET],
-            skip: [r.skip; PACKET],
-        }
-    }
-
-    #[inline(always)]
-    pub fn ray(&self, i: usize) -> Ray {
-        Ray {
-            o: Vec3::new(self.o[0][i], self.o[1][i], self.o[2][i]),
-            d: self.d(i),
-            tmin: self.tmin[i],
-            tmax: self.tmax[i],
-            skip: self.skip[i],
-        }
-    }
-
-    /// Lane i's direction.
-    #[inline(always)]
-    pub fn d(&self, i: usize) -> Vec3 {
-        Vec3::new(self.d[0][i], self.d[1][i], self.d[2][i])
-    }
-
-    #[inline(always)]
-    pub fn set(&mut self, i: usize, r: &Ray) {
-        for a in 0..3 {
-            (self.o[a][i], self.d[a][i]) = (r.o[a], r.d[a]);
-        }
-        (self.tmin[i], self.tmax[i], self.skip[i]) = (r.tmin, r.tmax, r.skip);
-    }
-}
-
-impl Default for RayPacket {
-    /// Eight copies of an unbounded ray along +z from the origin.
-    fn default() -> Self {
-        RayPacket::splat(&Ray::new(Vec3::ZERO, Vec3::Z))
-    }
-}
 
 /// Iterates the set bits of a mask, lowest first.
 #[inline(always)]
@@ -322,16 +267,13 @@ impl<'a> Rays<'a> {
 
 impl Accel {
     /// `intersect` for each ray set in `active`, traced as one packet.
-    pub fn intersect8(
-        &self,
-        rays: &RayPacket,
-        active: u32,
-        shapes: &[Shape],
-    ) -> [Option<Hit>; PACKET] {
-        let mut out = [None; PACKET];
+    pub fn intersect8(&self, rays: &RayPacket, active: u32, shapes: &[Shape]) -> PacketHits {
+        let mut out = PacketHits::default();
         if active.count_ones() <= 1 {
             for i in bits(active) {
-                out[i] = self.intersect(&rays.ray(i), shapes);
+                if let Some(hit) = self.intersect(&rays.ray(i), shapes) {
+                    out.set(i, &hit);
+                }
             }
             return out;
         }
@@ -396,20 +338,50 @@ impl Accel {
                     }
                 }
             });
+        // Hits on meshes without vertex normals (flat shading) gather their triangle here and
+        // get their points in lanes below; others get `surface_point`'s, one by one.
+        let (mut flat, mut v, mut b1, mut b2) = (0u32, [[[0.0; PACKET]; 3]; 3], [0.0; 8], [0.0; 8]);
         for i in bits(active) {
             // As `closest`: a hit only if it shortened the ray.
             if best[i].0 == u32::MAX || !(tmax[i] < rays.tmax[i]) {
                 continue;
             }
-            let t = tmax[i];
-            let sp = surface_point(
-                shapes,
-                self.refs[best[i].0 as usize],
-                best[i].1,
-                &rays.ray(i),
-                t,
-            );
-            out[i] = Some(Hit { t, sp });
+            let (shape, local) = self.refs[best[i].0 as usize];
+            (out.t[i], out.shape[i], out.prim[i]) = (tmax[i], shape, local);
+            out.mask |= 1 << i;
+            match &shapes[shape as usize].kind {
+                ShapeKind::Mesh(m) if m.normals.is_none() => {
+                    for (k, p) in m.vertices(local as usize).into_iter().enumerate() {
+                        for a in 0..3 {
+                            v[k][a][i] = p[a];
+                        }
+                    }
+                    let (ng, err) = m.face(local as usize);
+                    for a in 0..3 {
+                        (out.ng[a][i], out.ns[a][i], out.err[a][i]) = (ng[a], ng[a], err[a]);
+                    }
+                    (b1[i], b2[i]) = (best[i].1.x, best[i].1.y);
+                    flat |= 1 << i;
+                }
+                _ => {
+                    let sp =
+                        surface_point(shapes, (shape, local), best[i].1, &rays.ray(i), tmax[i]);
+                    out.set_point(i, &sp);
+                }
+            }
+        }
+        if flat != 0 {
+            // `Mesh::point_from`'s position, the same IEEE operations in each lane.
+            let (b1, b2) = (F8::load(&b1), F8::load(&b2));
+            let b0 = F8::splat(1.0).sub(b1).sub(b2);
+            let m = M8::from_bits(flat);
+            for (a, out_p) in out.p.iter_mut().enumerate() {
+                let p = F8::load(&v[0][a])
+                    .mul(b0)
+                    .add(F8::load(&v[1][a]).mul(b1))
+                    .add(F8::load(&v[2][a]).mul(b2));
+                F8::select(m, p, F8::load(out_p)).store(out_p);
+            }
         }
         out
     }
@@ -548,13 +520,34 @@ mod tests {
     }
 
     /// Packets of coherent and of scattered rays, with and without a shared dominant axis,
-    /// get each ray's own closest hit and occlusion answer, bitwise, from the bundled Cornell
-    /// box's and Veach scene's geometry (triangles and spheres).
+    /// get each ray's own closest hit (with its surface point) and occlusion answer, bitwise,
+    /// from the bundled Cornell box's and Veach scene's geometry (flat triangles and spheres),
+    /// and from the Cornell box with vertex normals on half its meshes (smooth shading).
     #[test]
     fn packets_match_single_rays() {
-        for path in ["scenes/cbox/cbox.xml", "scenes/veach-mis/veach-mis.xml"] {
-            let desc = crate::scene::load_scene(std::path::Path::new(path), &[]).expect(path);
+        use crate::scene::desc::ShapeGeometry;
+        let cbox = "scenes/cbox/cbox.xml";
+        for (path, smooth) in [
+            (cbox, false),
+            ("scenes/veach-mis/veach-mis.xml", false),
+            (cbox, true),
+        ] {
+            let mut desc = crate::scene::load_scene(std::path::Path::new(path), &[]).expect(path);
+            if smooth {
+                for shape in desc.shapes.iter_mut().step_by(2) {
+                    if let ShapeGeometry::Mesh {
+                        positions, normals, ..
+                    } = &mut shape.geometry
+                    {
+                        *normals = Some(positions.iter().map(|p| p.normalize()).collect());
+                    }
+                }
+            }
             let scene = crate::scene::Scene::build(desc).expect(path);
+            let smooth_meshes = scene.shapes.iter().filter(
+                |s| matches!(&s.kind, crate::geometry::ShapeKind::Mesh(m) if m.normals.is_some()),
+            );
+            assert_eq!(smooth_meshes.count() > 0, smooth, "{path}");
             let accel = &scene.accel;
             let shapes = &scene.shapes;
             let (lo, hi) = accel.bounds();
@@ -587,17 +580,19 @@ mod tests {
                 let occluded = accel.occluded8(&packet, active);
                 for (i, ray) in rays.iter().enumerate() {
                     let want = accel.intersect(ray, shapes);
-                    let key = |h: &Option<Hit>| {
+                    let key = |h: &Option<crate::geometry::Hit>| {
                         h.map(|h| {
-                            (
-                                h.t.to_bits(),
-                                h.sp.shape,
-                                h.sp.prim,
-                                h.sp.p.to_array().map(f32::to_bits),
-                            )
+                            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                            let sp = h.sp;
+                            let vectors = [sp.p, sp.ng, sp.ns, sp.err_scale].map(bits);
+                            (h.t.to_bits(), sp.shape, sp.prim, vectors)
                         })
                     };
-                    assert_eq!(key(&got[i]), key(&want), "{path}: round {round}, ray {i}");
+                    assert_eq!(
+                        key(&got.get(i)),
+                        key(&want),
+                        "{path}: round {round}, ray {i}"
+                    );
                     let blocked_one = accel.occluded(ray);
                     assert_eq!(
                         occluded >> i & 1 != 0,

@@ -170,18 +170,23 @@ impl Direct<'_> {
         out: &mut [Rgb; LANES],
     ) -> CameraHits {
         let scene = self.scene;
+        let camera = scene.intersect8(rays, (1 << n) - 1);
+        // Taken whole; lanes the loop below does not cover are dropped later.
         let mut h = CameraHits {
+            p: V3x8::from_axes(camera.p),
+            ng: V3x8::from_axes(camera.ng),
+            ns: V3x8::from_axes(camera.ns),
+            err: V3x8::from_axes(camera.err),
             d: V3x8::from_axes(rays.d),
             ..CameraHits::default()
         };
         let mut batch = None;
-        let camera = scene.intersect8(rays, (1 << n) - 1);
         for i in 0..n {
-            let Some(hit) = camera[i] else {
+            if camera.mask >> i & 1 == 0 {
                 continue;
-            };
-            let sp = hit.sp;
-            let shape = &shapes[sp.shape as usize];
+            }
+            let (shape_id, prim) = (camera.shape[i], camera.prim[i]);
+            let shape = &shapes[shape_id as usize];
             // The batch takes the kind of its first covered hit; hits of the other kind (at a
             // pixel straddling two materials) and uncovered materials take the scalar path.
             let rough = match shape.material {
@@ -202,22 +207,18 @@ impl Direct<'_> {
                 LaneMaterial::Other => None,
             };
             if rough.is_none_or(|r| r != *batch.get_or_insert(r)) {
-                out[i] = self.li_hit(&rays.ray(i), &sp, &mut rng.lane(i));
+                out[i] = self.li_hit(&rays.ray(i), &camera.point(i), &mut rng.lane(i));
                 continue;
             }
             let mut l = Rgb::ZERO;
             if !self.strategy.hide_emitters {
                 if let Some(e) = shape.emitter {
-                    l += scene.emitters[e as usize].le(&sp, -rays.d(i));
+                    l += scene.emitters[e as usize].le(&camera.point(i), -rays.d(i));
                 }
             }
             h.l[i] = Some(l);
-            h.p.set(i, sp.p);
-            h.ng.set(i, sp.ng);
-            h.ns.set(i, sp.ns);
-            h.err.set(i, sp.err_scale);
-            h.skip[i] = Accel::skip_from(shape.skip_base, sp.prim);
-            h.emitter_skip[i] = Accel::skip_from(shape.emitter_skip_base, sp.prim);
+            h.skip[i] = Accel::skip_from(shape.skip_base, prim);
+            h.emitter_skip[i] = Accel::skip_from(shape.emitter_skip_base, prim);
         }
         h.rough = batch == Some(true);
         h

@@ -9,7 +9,7 @@ use crate::camera::Camera;
 use crate::emitter::{AreaLight, Emitter, LightSample, PointLight};
 use crate::geometry::packet::PACKET;
 use crate::geometry::{
-    Accel, Hit, Mesh, Ray, RayPacket, Shape, ShapeKind, Sphere, SurfacePoint, NO_SKIP,
+    Accel, Hit, Mesh, PacketHits, Ray, RayPacket, Shape, ShapeKind, Sphere, SurfacePoint, NO_SKIP,
 };
 use crate::math::{offset_origin, Rgb};
 use crate::sampling::microfacet::Microfacet;
@@ -315,7 +315,7 @@ impl Scene {
 
     /// `intersect` of each ray set in `active`, traced as one packet.
     #[inline]
-    pub fn intersect8(&self, rays: &RayPacket, active: u32) -> [Option<Hit>; PACKET] {
+    pub fn intersect8(&self, rays: &RayPacket, active: u32) -> PacketHits {
         self.accel.intersect8(rays, active, &self.shapes)
     }
 

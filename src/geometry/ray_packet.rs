@@ -1,0 +1,125 @@
+//! A packet's rays and closest hits, one array per component: the form the packet tests
+//! read and write, and the form the lane kernel and the camera compute in, so that nothing is
+//! transposed between them.
+
+use super::packet::PACKET;
+use super::{Hit, Ray, SurfacePoint};
+use glam::Vec3;
+
+/// Up to eight rays, one array per component. Packets are traced in this form, and the lane
+/// kernel and the camera compute their rays in it, so no packet is transposed on the way.
+/// Lanes outside a query's active mask may hold anything (even NaN): no answer reads them.
+#[derive(Clone, Copy, Debug)]
+pub struct RayPacket {
+    pub o: [[f32; PACKET]; 3],
+    pub d: [[f32; PACKET]; 3],
+    pub tmin: [f32; PACKET],
+    pub tmax: [f32; PACKET],
+    pub skip: [u32; PACKET],
+}
+
+impl RayPacket {
+    /// Eight copies of a ray.
+    pub fn splat(r: &Ray) -> Self {
+        RayPacket {
+            o: r.o.to_array().map(|c| [c; PACKET]),
+            d: r.d.to_array().map(|c| [c; PACKET]),
+            tmin: [r.tmin; PACKET],
+            tmax: [r.tmax; PACKET],
+            skip: [r.skip; PACKET],
+        }
+    }
+
+    #[inline(always)]
+    pub fn ray(&self, i: usize) -> Ray {
+        Ray {
+            o: Vec3::new(self.o[0][i], self.o[1][i], self.o[2][i]),
+            d: self.d(i),
+            tmin: self.tmin[i],
+            tmax: self.tmax[i],
+            skip: self.skip[i],
+        }
+    }
+
+    /// Lane i's direction.
+    #[inline(always)]
+    pub fn d(&self, i: usize) -> Vec3 {
+        Vec3::new(self.d[0][i], self.d[1][i], self.d[2][i])
+    }
+
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, r: &Ray) {
+        for a in 0..3 {
+            (self.o[a][i], self.d[a][i]) = (r.o[a], r.d[a]);
+        }
+        (self.tmin[i], self.tmax[i], self.skip[i]) = (r.tmin, r.tmax, r.skip);
+    }
+}
+
+impl Default for RayPacket {
+    /// Eight copies of an unbounded ray along +z from the origin.
+    fn default() -> Self {
+        RayPacket::splat(&Ray::new(Vec3::ZERO, Vec3::Z))
+    }
+}
+
+/// A packet's closest hits. Lanes outside `mask` hold anything.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PacketHits {
+    /// The lanes with a hit.
+    pub mask: u32,
+    pub t: [f32; PACKET],
+    pub p: [[f32; PACKET]; 3],
+    pub ng: [[f32; PACKET]; 3],
+    pub ns: [[f32; PACKET]; 3],
+    pub err: [[f32; PACKET]; 3],
+    pub shape: [u32; PACKET],
+    pub prim: [u32; PACKET],
+}
+
+/// Lane i of three arrays.
+#[inline(always)]
+fn lane(v: &[[f32; PACKET]; 3], i: usize) -> Vec3 {
+    Vec3::new(v[0][i], v[1][i], v[2][i])
+}
+
+impl PacketHits {
+    /// Lane i's hit, if it has one.
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Option<Hit> {
+        (self.mask >> i & 1 != 0).then(|| Hit {
+            t: self.t[i],
+            sp: self.point(i),
+        })
+    }
+
+    /// Lane i's surface point (anything if lane i has no hit).
+    #[inline(always)]
+    pub fn point(&self, i: usize) -> SurfacePoint {
+        SurfacePoint {
+            p: lane(&self.p, i),
+            ng: lane(&self.ng, i),
+            ns: lane(&self.ns, i),
+            shape: self.shape[i],
+            prim: self.prim[i],
+            err_scale: lane(&self.err, i),
+        }
+    }
+
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, hit: &Hit) {
+        self.mask |= 1 << i;
+        self.t[i] = hit.t;
+        self.set_point(i, &hit.sp);
+    }
+
+    /// Lane i's surface point, leaving its mask bit and distance alone.
+    #[inline(always)]
+    pub fn set_point(&mut self, i: usize, sp: &SurfacePoint) {
+        for a in 0..3 {
+            (self.p[a][i], self.ng[a][i]) = (sp.p[a], sp.ng[a]);
+            (self.ns[a][i], self.err[a][i]) = (sp.ns[a], sp.err_scale[a]);
+        }
+        (self.shape[i], self.prim[i]) = (sp.shape, sp.prim);
+    }
+}
