@@ -53,11 +53,12 @@ struct PixelStats {
 impl PixelStats {
     #[inline]
     fn push(&mut self, v: glam::Vec3) {
-        for c in 0..3 {
-            let x = v[c] as f64;
-            if self.n == 0 {
-                self.shift[c] = x;
-            }
+        let x = [v.x as f64, v.y as f64, v.z as f64];
+        // One test per sample rather than per channel: the channel loop then has no branch.
+        if self.n == 0 {
+            self.shift = x;
+        }
+        for (c, x) in x.into_iter().enumerate() {
             let d = x - self.shift[c];
             self.s1[c] += d;
             self.s2[c] += d * d;
@@ -91,6 +92,14 @@ struct PixelResult {
     non_finite: u64,
 }
 
+/// `Vec3::is_finite` without its short-circuit branches: x - x is 0 for a finite x and NaN
+/// for an infinite or NaN one, and NaN carries through the sum.
+#[inline(always)]
+#[allow(clippy::eq_op)] // x - x is the test, not a slip
+fn is_finite(v: glam::Vec3) -> bool {
+    (v.x - v.x) + (v.y - v.y) + (v.z - v.z) == 0.0
+}
+
 fn render_pixel(direct: &Direct, x: u32, y: u32, settings: &RenderSettings) -> PixelResult {
     let cam = &direct.scene.camera;
     let pixel = y as u64 * cam.width as u64 + x as u64;
@@ -107,7 +116,7 @@ fn render_pixel(direct: &Direct, x: u32, y: u32, settings: &RenderSettings) -> P
         let n = (settings.spp - s0).min(LANES as u32) as usize;
         let values = direct.li_lanes(&rays, n, &mut lanes);
         for mut v in values.into_iter().take(n) {
-            if !v.is_finite() {
+            if !is_finite(v) {
                 // Counted and reported; a correct estimator never gets here (tests assert 0).
                 non_finite += 1;
                 v = glam::Vec3::ZERO;
@@ -199,6 +208,35 @@ mod tests {
         let m = x.iter().sum::<f64>() / n;
         let v = x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0);
         (m, v / n)
+    }
+
+    #[test]
+    fn is_finite_is_glams() {
+        let xs = [
+            0.0,
+            -0.0,
+            1.0,
+            -3.4e38,
+            f32::MAX,
+            f32::MIN_POSITIVE,
+            1e-45,
+            f32::INFINITY,
+        ];
+        let xs = xs
+            .into_iter()
+            .chain([f32::NEG_INFINITY, f32::NAN, -f32::NAN]);
+        let xs: Vec<f32> = xs.collect();
+        for &a in &xs {
+            for &b in &xs {
+                for v in [
+                    Vec3::new(a, b, 1.0),
+                    Vec3::new(1.0, a, b),
+                    Vec3::new(b, 2.0, a),
+                ] {
+                    assert_eq!(super::is_finite(v), v.is_finite(), "{v:?}");
+                }
+            }
+        }
     }
 
     #[test]
