@@ -290,11 +290,41 @@ mod tests {
         let no_point_lights = |d: &mut SceneDesc| d.point_lights.clear();
         let tent = |d: &mut SceneDesc| d.film.filter = FilterDesc::Tent { radius: 1.0 };
         let keep = |_: &mut SceneDesc| {};
+        // Vertex normals on the light mesh, tilted away from its face normal by up to 0.2
+        // towards each vertex's offset from the centroid: light points with shading normals.
+        let smooth_light = |d: &mut SceneDesc| {
+            use crate::scene::desc::ShapeGeometry;
+            for shape in d.shapes.iter_mut().filter(|s| s.emitter.is_some()) {
+                if let ShapeGeometry::Mesh {
+                    positions,
+                    normals,
+                    indices,
+                } = &mut shape.geometry
+                {
+                    let [a, b, c] = indices[0].map(|i| positions[i as usize]);
+                    let ng = (b - a).cross(c - a).normalize();
+                    let centre = positions.iter().sum::<Vec3>() / positions.len() as f32;
+                    let size = positions
+                        .iter()
+                        .map(|p| p.distance(centre))
+                        .fold(0.0, f32::max);
+                    let tilt = |p: Vec3| (ng + 0.2 * (p - centre) / size).normalize();
+                    *normals = Some(positions.iter().map(|&p| tilt(p)).collect());
+                }
+            }
+        };
         type Edit = dyn Fn(&mut SceneDesc);
-        let cases: [(&str, &Edit, crate::integrator::Strategy, bool); 7] = [
+        let cases: [(&str, &Edit, crate::integrator::Strategy, bool); 8] = [
             ("cbox/cbox.xml", &keep, mis, true),
             // A light mesh of many triangles: the lanes' per-triangle records.
             ("cbox-meshlight/cbox-meshlight.xml", &keep, power, true),
+            // The same with vertex normals: the lanes' smooth light points.
+            (
+                "cbox-meshlight/cbox-meshlight.xml",
+                &smooth_light,
+                power,
+                true,
+            ),
             (
                 "cbox/cbox.xml",
                 &keep,

@@ -14,19 +14,35 @@ use crate::scene::desc::StrategyKind;
 use crate::scene::Scene;
 use glam::Vec3;
 
-/// An emitter the lanes can sample: an area light and its shape (for a mesh, with its
-/// triangle table and its triangles' records).
-pub(super) enum LaneLight<'a> {
+/// An emitter the lanes can sample: what `light_draws` reads of its area light, copied in
+/// (behind the `AreaLight` it was one more cache line per lane), and its shape.
+pub(super) struct LaneLight<'a> {
+    pub(super) shape: u32,
+    pub(super) radiance: Vec3,
+    pub(super) area: f32,
+    pub(super) kind: LaneLightKind<'a>,
+}
+
+pub(super) enum LaneLightKind<'a> {
+    /// A mesh, with its triangle table, its triangles' records, and the mesh itself where it
+    /// has vertex normals (None for flat meshes, which then need no look at the mesh).
     Mesh {
-        light: &'a AreaLight,
-        mesh: &'a Mesh,
         triangles: &'a AliasTable,
         records: Vec<LightTriangle>,
+        smooth: Option<&'a Mesh>,
     },
-    Sphere {
-        light: &'a AreaLight,
-        sphere: &'a Sphere,
-    },
+    Sphere(&'a Sphere),
+}
+
+impl<'a> LaneLight<'a> {
+    fn new(light: &AreaLight, kind: LaneLightKind<'a>) -> Self {
+        LaneLight {
+            shape: light.shape,
+            radiance: light.radiance,
+            area: light.area,
+            kind,
+        }
+    }
 }
 
 /// What `light_draws` reads of a light triangle, in one 64-byte record: `Mesh` keeps the
@@ -131,15 +147,19 @@ fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>>
         .map(|e| match e {
             Emitter::Area(light) => {
                 match (&scene.shapes[light.shape as usize].kind, &light.triangles) {
-                    (ShapeKind::Mesh(mesh), Some(triangles)) => Some(LaneLight::Mesh {
-                        light,
-                        mesh,
-                        triangles,
-                        records: (0..triangles.len())
-                            .map(|t| LightTriangle::of(mesh, t))
-                            .collect(),
-                    }),
-                    (ShapeKind::Sphere(sphere), _) => Some(LaneLight::Sphere { light, sphere }),
+                    (ShapeKind::Mesh(mesh), Some(triangles)) => {
+                        let kind = LaneLightKind::Mesh {
+                            triangles,
+                            records: (0..triangles.len())
+                                .map(|t| LightTriangle::of(mesh, t))
+                                .collect(),
+                            smooth: mesh.normals.is_some().then_some(mesh),
+                        };
+                        Some(LaneLight::new(light, kind))
+                    }
+                    (ShapeKind::Sphere(sphere), _) => {
+                        Some(LaneLight::new(light, LaneLightKind::Sphere(sphere)))
+                    }
                     _ => None,
                 }
             }
@@ -246,10 +266,24 @@ mod tests {
         let scene = Scene::build(load("cbox-meshlight/cbox-meshlight.xml")).unwrap();
         let lanes = lane_setup(&scene, &mis()).expect("covered");
         let mut checked = 0;
-        for light in &lanes.lights {
-            let LaneLight::Mesh { mesh, records, .. } = light else {
+        for (light, e) in lanes.lights.iter().zip(&scene.emitters) {
+            let LaneLightKind::Mesh {
+                records, smooth, ..
+            } = &light.kind
+            else {
                 continue;
             };
+            let Emitter::Area(area) = e else {
+                panic!("a lane light is an area light");
+            };
+            assert_eq!(
+                (light.shape, light.radiance, light.area),
+                (area.shape, area.radiance, area.area)
+            );
+            let ShapeKind::Mesh(mesh) = &scene.shapes[area.shape as usize].kind else {
+                panic!("a mesh light's shape is a mesh");
+            };
+            assert_eq!(smooth.is_some(), mesh.normals.is_some());
             assert_eq!(records.len(), mesh.indices.len());
             for (t, r) in records.iter().enumerate() {
                 assert_eq!(r.v, mesh.vertices(t));

@@ -19,7 +19,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::direct::{heuristic, Direct};
-use super::lane_tables::{LaneLight, LaneMaterial, LaneShape};
+use super::lane_tables::{LaneLight, LaneLightKind, LaneMaterial, LaneShape};
 use crate::bsdf::{BsdfSample, Diffuse};
 use crate::emitter::{area_pdf_along, sample_at, sphere_area_point};
 use crate::geometry::{Accel, Mesh, RayPacket, Sphere, SurfacePoint};
@@ -238,19 +238,18 @@ impl Direct<'_> {
             let Some((e, pmf)) = self.selector.sample(u_emitter[i]) else {
                 continue;
             };
-            let (LaneLight::Mesh { light, .. } | LaneLight::Sphere { light, .. }) = &lights[e];
+            let light = &lights[e];
             d.shape[i] = light.shape;
             d.radiance.set(i, light.radiance);
             d.area[i] = light.area;
             d.pmf[i] = pmf;
-            let (mesh, triangles, records) = match &lights[e] {
-                LaneLight::Mesh {
-                    mesh,
+            let (triangles, records, smooth) = match &light.kind {
+                LaneLightKind::Mesh {
                     triangles,
                     records,
-                    ..
-                } => (mesh, triangles, records),
-                LaneLight::Sphere { sphere, .. } => {
+                    smooth,
+                } => (triangles, records, smooth),
+                LaneLightKind::Sphere(sphere) => {
                     (spheres.sphere[i], spheres.any) = (Some(**sphere), true);
                     continue;
                 }
@@ -260,7 +259,7 @@ impl Direct<'_> {
             for (k, v) in r.v.into_iter().enumerate() {
                 d.v[k].set(i, v);
             }
-            if let Some(n) = mesh.vertex_normals(tri) {
+            if let Some(n) = smooth.and_then(|m| m.vertex_normals(tri)) {
                 for (k, n) in n.into_iter().enumerate() {
                     d.n[k].set(i, n);
                 }
