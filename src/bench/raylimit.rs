@@ -16,6 +16,7 @@
 //! tens of MB from memory.
 
 use crate::emitter::{EmitterSelection, EmitterSelector, LightSampling};
+use crate::geometry::packet::bits;
 use crate::geometry::shape::intersect_sphere;
 use crate::geometry::{Hit, PacketHits, Ray, RayPacket, ShapeKind};
 use crate::math::{Frame, Rgb};
@@ -280,14 +281,9 @@ type BsdfPacket = (RayPacket, [u32; LANES], u32);
 /// lanes, then `bsdf_ray_hit_traced` of each ray it lets through.
 #[inline(always)]
 fn bsdf_queries(scene: &Scene, (rays, skips, active): &BsdfPacket) -> usize {
-    let mut sink = 0;
-    let mut may = scene.bsdf_rays_may_hit(rays, *active);
-    while may != 0 {
-        let i = may.trailing_zeros() as usize;
-        may &= may - 1;
-        sink += prim(scene.bsdf_ray_hit_traced(&rays.ray(i), skips[i]));
-    }
-    sink
+    bits(scene.bsdf_rays_may_hit(rays, *active))
+        .map(|i| prim(scene.bsdf_ray_hit_traced(&rays.ray(i), skips[i])))
+        .sum()
 }
 
 impl Warm {

@@ -15,8 +15,7 @@ use super::bvh::{push_by_distance, read, slab_test, Node, WideBvh};
 use super::bvh::{LEAF, ROBUST, STACK};
 use super::lanes8::{F8, M8};
 use super::ray_packet::{PacketHits, RayPacket};
-use super::shape::intersect_sphere;
-use super::shape::ShapeKind;
+use super::shape::{intersect_sphere, ShapeKind};
 use super::watertight8::{Lanes3, Rays8, WatertightRay8};
 use super::{Ray, Shape};
 use glam::Vec2;
@@ -27,7 +26,7 @@ pub const PACKET: usize = 8;
 
 /// Iterates the set bits of a mask, lowest first.
 #[inline(always)]
-fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+pub fn bits(mut m: u32) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
         (m != 0).then(|| {
             let i = m.trailing_zeros() as usize;
@@ -340,7 +339,8 @@ impl Accel {
             });
         // Hits on meshes without vertex normals (flat shading) gather their triangle here and
         // get their points in lanes below; others get `surface_point`'s, one by one.
-        let (mut flat, mut v, mut b1, mut b2) = (0u32, [[[0.0; PACKET]; 3]; 3], [0.0; 8], [0.0; 8]);
+        let (mut flat, mut v) = (0u32, [[[0.0; PACKET]; 3]; 3]);
+        let (mut b1, mut b2) = ([0.0; PACKET], [0.0; PACKET]);
         for i in bits(active) {
             // As `closest`: a hit only if it shortened the ray.
             if best[i].0 == u32::MAX || !(tmax[i] < rays.tmax[i]) {

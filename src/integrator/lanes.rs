@@ -22,6 +22,7 @@ use super::direct::{heuristic, Direct};
 use super::lane_tables::{LaneLight, LaneLightKind, LaneMaterial, LaneShape};
 use crate::bsdf::{BsdfSample, Diffuse};
 use crate::emitter::{area_pdf_along, sample_at, sphere_area_point};
+use crate::geometry::packet::bits;
 use crate::geometry::{Accel, Mesh, RayPacket, Sphere, SurfacePoint};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
@@ -379,10 +380,7 @@ impl Direct<'_> {
             open |= ((h.l[i].is_some() && sh.bsdf_ok[i]) as u32) << i;
         }
         let mut bsdf = V3x8::default();
-        let mut may = scene.bsdf_rays_may_hit(&bsdf_rays, open);
-        while may != 0 {
-            let i = may.trailing_zeros() as usize;
-            may &= may - 1;
+        for i in bits(scene.bsdf_rays_may_hit(&bsdf_rays, open)) {
             let ray = bsdf_rays.ray(i);
             if let Some(hit) = scene.bsdf_ray_hit_traced(&ray, h.emitter_skip[i]) {
                 let bs = BsdfSample {
