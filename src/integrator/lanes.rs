@@ -85,8 +85,9 @@ pub(super) struct CameraHits {
     /// Accelerator skip ids of the hit triangle (all rays, emitter-only structure).
     skip: [u32; LANES],
     emitter_skip: [u32; LANES],
-    /// The estimate so far (emission seen at the hit); None for lanes not shaded here.
-    pub(super) l: [Option<Rgb>; LANES],
+    /// The lanes shaded here, and their estimate so far (the emission seen at the hit).
+    pub(super) covered: u32,
+    le: V3x8,
 }
 
 /// The sphere of each lane whose light is a sphere. Kept out of `LightDraws`: with these
@@ -217,7 +218,8 @@ impl Direct<'_> {
                     l += scene.emitters[e as usize].le(&camera.point(i), -rays.d(i));
                 }
             }
-            h.l[i] = Some(l);
+            h.le.set(i, l);
+            h.covered |= 1 << i;
             h.skip[i] = Accel::skip_from(shape.skip_base, prim);
             h.emitter_skip[i] = Accel::skip_from(shape.emitter_skip_base, prim);
         }
@@ -361,10 +363,7 @@ impl Direct<'_> {
         // Every lane's ray is computed; only those of covered lanes with a light sample
         // are traced.
         let shadow = Scene::shadow_rays_to(&sh.shadow_o.axes(), &sh.shadow_target.axes(), &h.skip);
-        let mut traced = 0u32;
-        for i in 0..LANES {
-            traced |= ((h.l[i].is_some() && sh.light_ok[i]) as u32) << i;
-        }
+        let traced = h.covered & mask_of(&sh.light_ok);
         let blocked = scene.accel.occluded8(&shadow, traced);
         // The BSDF rays, put through `bsdf_ray_hit`'s box reject in lanes: only those it lets
         // through are traced, one by one.
@@ -375,10 +374,7 @@ impl Direct<'_> {
             tmax: [f32::INFINITY; LANES],
             skip: h.skip,
         };
-        let mut open = 0u32;
-        for i in 0..LANES {
-            open |= ((h.l[i].is_some() && sh.bsdf_ok[i]) as u32) << i;
-        }
+        let open = h.covered & mask_of(&sh.bsdf_ok);
         let mut bsdf = V3x8::default();
         for i in bits(scene.bsdf_rays_may_hit(&bsdf_rays, open)) {
             let ray = bsdf_rays.ray(i);
@@ -392,17 +388,31 @@ impl Direct<'_> {
                 bsdf.set(i, self.bsdf_emission(h.p.get(i), ray.d, &hit, &bs, bsdf_w));
             }
         }
+        // `li`'s sum, in its order, for all lanes at once; only covered lanes are kept.
+        let lit = traced & !blocked;
+        let mut sum = V3x8::default();
         for i in 0..LANES {
-            let Some(mut l) = h.l[i] else {
-                continue;
+            let light = if lit >> i & 1 != 0 {
+                sh.light.get(i)
+            } else {
+                Rgb::ZERO
             };
-            let lit = traced >> i & 1 != 0 && blocked >> i & 1 == 0;
-            let light = if lit { sh.light.get(i) } else { Rgb::ZERO };
-            l += light / ne;
-            l += bsdf.get(i) / nb;
-            out[i] = l;
+            sum.set(i, h.le.get(i) + light / ne + bsdf.get(i) / nb);
+        }
+        for i in bits(h.covered) {
+            out[i] = sum.get(i);
         }
     }
+}
+
+/// The lanes whose flag is set, as a mask.
+#[inline(always)]
+fn mask_of(flags: &[bool; LANES]) -> u32 {
+    let mut m = 0;
+    for (i, &f) in flags.iter().enumerate() {
+        m |= (f as u32) << i;
+    }
+    m
 }
 
 /// Lane i's light sample: the area-sampling branches of `AreaLight::sample` for the drawn

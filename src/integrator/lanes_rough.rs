@@ -124,7 +124,7 @@ impl Direct<'_> {
         for i in 0..LANES {
             // Lanes without a covered hit hold garbage (NaN), which would bisect to the
             // 64-step limit: their samples are dropped, so they take no more steps.
-            if !vis.done[i] && h.l[i].is_some() {
+            if !vis.done[i] && h.covered >> i & 1 != 0 {
                 let mut b = vis.get(i);
                 b.slope.finish();
                 vis.set(i, b);
