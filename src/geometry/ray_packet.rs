@@ -6,6 +6,12 @@ use super::packet::PACKET;
 use super::{Hit, Ray, SurfacePoint};
 use glam::Vec3;
 
+/// Lane i of three arrays.
+#[inline(always)]
+fn lane(v: &[[f32; PACKET]; 3], i: usize) -> Vec3 {
+    Vec3::new(v[0][i], v[1][i], v[2][i])
+}
+
 /// Up to eight rays, one array per component. Packets are traced in this form, and the lane
 /// kernel and the camera compute their rays in it, so no packet is transposed on the way.
 /// Lanes outside a query's active mask may hold anything (even NaN): no answer reads them.
@@ -33,7 +39,7 @@ impl RayPacket {
     #[inline(always)]
     pub fn ray(&self, i: usize) -> Ray {
         Ray {
-            o: Vec3::new(self.o[0][i], self.o[1][i], self.o[2][i]),
+            o: lane(&self.o, i),
             d: self.d(i),
             tmin: self.tmin[i],
             tmax: self.tmax[i],
@@ -44,7 +50,7 @@ impl RayPacket {
     /// Lane i's direction.
     #[inline(always)]
     pub fn d(&self, i: usize) -> Vec3 {
-        Vec3::new(self.d[0][i], self.d[1][i], self.d[2][i])
+        lane(&self.d, i)
     }
 
     #[inline(always)]
@@ -75,12 +81,6 @@ pub struct PacketHits {
     pub err: [[f32; PACKET]; 3],
     pub shape: [u32; PACKET],
     pub prim: [u32; PACKET],
-}
-
-/// Lane i of three arrays.
-#[inline(always)]
-fn lane(v: &[[f32; PACKET]; 3], i: usize) -> Vec3 {
-    Vec3::new(v[0][i], v[1][i], v[2][i])
 }
 
 impl PacketHits {
