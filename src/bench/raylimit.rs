@@ -281,7 +281,7 @@ type BsdfPacket = (RayPacket, [u32; LANES], u32);
 /// lanes, then `bsdf_ray_hit_traced` of each ray it lets through.
 #[inline(always)]
 fn bsdf_queries(scene: &Scene, (rays, skips, active): &BsdfPacket) -> usize {
-    bits(scene.bsdf_rays_may_hit(rays, *active))
+    bits(scene.bsdf_rays_may_hit::<true>(rays, *active))
         .map(|i| prim(scene.bsdf_ray_hit_traced(&rays.ray(i), skips[i])))
         .sum()
 }

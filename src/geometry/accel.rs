@@ -256,17 +256,41 @@ impl Accel {
         self.bvh.bounds()
     }
 
-    /// False only if the ray can hit nothing here (see `WideBvh::may_enter`).
+    /// False only if the ray can hit nothing here (see `WideBvh::may_enter`). For a structure
+    /// of a few spheres the answer is exact, `occluded`'s (see `may_hit_is_occluded`).
     #[inline(always)]
     pub fn may_hit(&self, ray: &Ray) -> bool {
         self.bvh.may_enter(ray.o, ray.d, ray.tmin, ray.tmax)
+            && self
+                .spheres8
+                .as_ref()
+                .is_none_or(|s| s.any(ray.o, ray.d, ray.tmin, ray.tmax))
     }
 
-    /// `may_hit` of each ray of a packet: bit i is lane i's answer.
+    /// `may_hit`'s box reject of each ray of a packet: bit i is lane i's answer.
     #[inline(always)]
     pub fn may_hit8(&self, rays: &RayPacket) -> u32 {
         self.bvh
             .may_enter8(&rays.o, &rays.d, &rays.tmin, &rays.tmax)
+    }
+
+    /// The rest of `may_hit` for the packet's rays set in `active`, which passed its box
+    /// reject: for a structure of a few spheres, the mask of those it hits (the rays in lanes,
+    /// the spheres one by one, where `occluded` takes the spheres in lanes ray by ray); else
+    /// `active` whole.
+    #[inline(always)]
+    pub fn may_hit8_past_box(&self, rays: &RayPacket, active: u32) -> u32 {
+        match &self.spheres8 {
+            Some(s) if active != 0 => s.any8(rays, active),
+            _ => active,
+        }
+    }
+
+    /// Whether `may_hit` answers exactly what `occluded` does, so a ray it lets through needs
+    /// no `occluded` query.
+    #[inline(always)]
+    pub fn may_hit_is_occluded(&self) -> bool {
+        self.spheres8.is_some()
     }
 
     /// True if anything blocks the ray within its interval.

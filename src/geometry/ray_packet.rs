@@ -39,12 +39,18 @@ impl RayPacket {
     #[inline(always)]
     pub fn ray(&self, i: usize) -> Ray {
         Ray {
-            o: lane(&self.o, i),
+            o: self.o(i),
             d: self.d(i),
             tmin: self.tmin[i],
             tmax: self.tmax[i],
             skip: self.skip[i],
         }
+    }
+
+    /// Lane i's origin.
+    #[inline(always)]
+    pub fn o(&self, i: usize) -> Vec3 {
+        lane(&self.o, i)
     }
 
     /// Lane i's direction.

@@ -6,6 +6,8 @@
 //! Each lane computes bitwise what `intersect_sphere` computes, so a ray that query hits is
 //! a hit here: the pre-test never drops a hit of the closest-hit query after it.
 
+use super::packet::{bits, PACKET};
+use super::ray_packet::RayPacket;
 use super::shape::sphere_roots;
 use glam::Vec3;
 
@@ -58,6 +60,34 @@ impl Spheres8 {
         }
         hit & self.used != 0
     }
+
+    /// `any` of each ray of a packet set in `active`, the rays in lanes and the spheres one
+    /// by one: bit i is lane i's answer. A sphere's exact test only runs if one of the
+    /// lanes still open passes its test without divisions (`any` leaves out the same ones).
+    /// Out of line: inlined, it cost the lane kernel's scenes without sphere lights ~0.3 %
+    /// of their instructions.
+    #[inline(never)]
+    pub fn any8(&self, rays: &RayPacket, active: u32) -> u32 {
+        let mut hit = 0u32;
+        for s in bits(self.used) {
+            let (c, r) = (
+                Vec3::new(self.c[0][s], self.c[1][s], self.c[2][s]),
+                self.r[s],
+            );
+            let mut near = 0u32;
+            for i in 0..PACKET {
+                near |= (may_hit_sphere(rays.o(i), rays.d(i), c, r) as u32) << i;
+            }
+            if near & active & !hit == 0 {
+                continue;
+            }
+            for i in 0..PACKET {
+                let h = hits_sphere(rays.o(i), rays.d(i), rays.tmin[i], rays.tmax[i], c, r);
+                hit |= (h as u32) << i;
+            }
+        }
+        hit & active
+    }
 }
 
 /// False only if the line through o along d passes the sphere so far from its centre that
@@ -85,6 +115,7 @@ fn hits_sphere(o: Vec3, d: Vec3, tmin: f32, tmax: f32, c: Vec3, r: f32) -> bool 
 mod tests {
     use super::*;
     use crate::geometry::shape::intersect_sphere;
+    use crate::geometry::Ray;
     use crate::rng::Rng;
     use crate::sampling::warps::square_to_uniform_sphere;
 
@@ -96,25 +127,9 @@ mod tests {
         let mut rng = Rng::new(3, 9);
         let (mut hits, mut misses) = (0, 0);
         for _ in 0..20_000 {
-            let n = 1 + rng.next_u32() as usize % SPHERES;
-            let spheres: Vec<(Vec3, f32)> = (0..n)
-                .map(|_| {
-                    let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 20.0 - 10.0;
-                    (c, 10f32.powf(rng.next_f32() * 5.0 - 3.0))
-                })
-                .collect();
+            let spheres = random_spheres(&mut rng);
             let lanes = Spheres8::new(spheres.iter().copied()).unwrap();
-            let (c, r) = spheres[rng.next_u32() as usize % n];
-            // From inside, near, and up to 1e6 radii away (where f32 loses the most).
-            let far = [4.0 * rng.next_f32(), 10f32.powf(6.0 * rng.next_f32())];
-            let o =
-                c + square_to_uniform_sphere(rng.next_2d()) * r * far[rng.next_u32() as usize % 2];
-            // Through a point near the rim: about half hit.
-            let rim =
-                c + square_to_uniform_sphere(rng.next_2d()) * r * (0.9 + 0.2 * rng.next_f32());
-            let d = (rim - o) * (0.1 + 10.0 * rng.next_f32());
-            let tmin = [0.0, 1e-4, 0.5][rng.next_u32() as usize % 3];
-            let tmax = [f32::INFINITY, 1.0, 0.3][rng.next_u32() as usize % 3];
+            let (o, d, tmin, tmax) = random_ray(&mut rng, &spheres);
             let want = spheres
                 .iter()
                 .any(|&(c, r)| intersect_sphere(o, d, tmin, tmax, c, r).is_some());
@@ -133,6 +148,70 @@ mod tests {
             hits > 5_000 && misses > 5_000,
             "{hits} hits, {misses} misses"
         );
+    }
+
+    /// Packets of such rays, each lane aimed at a sphere of its own, under random active
+    /// masks: `any8` answers lane by lane as `any` does, and nothing for inactive lanes.
+    #[test]
+    fn packets_answer_as_any() {
+        let mut rng = Rng::new(4, 1);
+        let (mut hits, mut misses) = (0, 0);
+        for _ in 0..5_000 {
+            let spheres = random_spheres(&mut rng);
+            let lanes = Spheres8::new(spheres.iter().copied()).unwrap();
+            let mut rays = RayPacket::default();
+            for i in 0..PACKET {
+                let (o, d, tmin, tmax) = random_ray(&mut rng, &spheres);
+                rays.set(
+                    i,
+                    &Ray {
+                        o,
+                        d,
+                        tmin,
+                        tmax,
+                        skip: 0,
+                    },
+                );
+            }
+            let active = rng.next_u32() & 0xff;
+            let got = lanes.any8(&rays, active);
+            for i in 0..PACKET {
+                let r = rays.ray(i);
+                let want = active >> i & 1 != 0 && lanes.any(r.o, r.d, r.tmin, r.tmax);
+                assert_eq!(got >> i & 1 != 0, want, "lane {i} of {active:#x}: {r:?}");
+                hits += want as u32;
+                misses += (active >> i & 1 != 0 && !want) as u32;
+            }
+        }
+        assert!(
+            hits > 5_000 && misses > 5_000,
+            "{hits} hits, {misses} misses"
+        );
+    }
+
+    /// One to eight spheres of radii 1e-3 to 1e2 in a box 20 wide.
+    fn random_spheres(rng: &mut Rng) -> Vec<(Vec3, f32)> {
+        let n = 1 + rng.next_u32() as usize % SPHERES;
+        (0..n)
+            .map(|_| {
+                let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 20.0 - 10.0;
+                (c, 10f32.powf(rng.next_f32() * 5.0 - 3.0))
+            })
+            .collect()
+    }
+
+    /// A ray at one of the spheres, from inside, near or far, through a point near its rim
+    /// (about half hit), with an interval that ends before, inside or after it.
+    fn random_ray(rng: &mut Rng, spheres: &[(Vec3, f32)]) -> (Vec3, Vec3, f32, f32) {
+        let (c, r) = spheres[rng.next_u32() as usize % spheres.len()];
+        // Up to 1e6 radii away, where f32 loses the most.
+        let far = [4.0 * rng.next_f32(), 10f32.powf(6.0 * rng.next_f32())];
+        let o = c + square_to_uniform_sphere(rng.next_2d()) * r * far[rng.next_u32() as usize % 2];
+        let rim = c + square_to_uniform_sphere(rng.next_2d()) * r * (0.9 + 0.2 * rng.next_f32());
+        let d = (rim - o) * (0.1 + 10.0 * rng.next_f32());
+        let tmin = [0.0, 1e-4, 0.5][rng.next_u32() as usize % 3];
+        let tmax = [f32::INFINITY, 1.0, 0.3][rng.next_u32() as usize % 3];
+        (o, d, tmin, tmax)
     }
 
     /// Lines aimed within 1e-3 of the rim, from 1 to 1e7 radii away: every one the exact test
@@ -179,7 +258,10 @@ mod tests {
         // The empty lanes hold spheres of radius 0 at the origin, which this ray passes
         // through: they must not count.
         assert!(!one.any(Vec3::new(0.0, 0.0, -1.0), -Vec3::Z, 0.0, f32::INFINITY));
+        let through_empty = Ray::new(Vec3::new(0.0, 0.0, -1.0), -Vec3::Z);
+        assert_eq!(one.any8(&RayPacket::splat(&through_empty), 0xff), 0);
         let none = Spheres8::new(std::iter::empty()).unwrap();
         assert!(!none.any(Vec3::new(0.0, 0.0, -1.0), Vec3::Z, 0.0, f32::INFINITY));
+        assert_eq!(none.any8(&RayPacket::default(), 0xff), 0);
     }
 }

@@ -286,7 +286,7 @@ impl Direct<'_> {
         out: &mut [Rgb; LANES],
     ) {
         let shaded = self.shade::<SPHERES>(h, ld, sd, u);
-        self.trace_and_sum(h, &shaded, out);
+        self.trace_and_sum::<SPHERES>(h, &shaded, out);
     }
 
     /// `shade_and_trace` for batches with a sphere light, out of line: the mesh-only kernel
@@ -355,7 +355,12 @@ impl Direct<'_> {
     /// The traversals (the shadow rays as one packet, then the BSDF rays one at a time) and
     /// the estimate of each covered lane, summed in `li`'s order.
     #[inline(always)]
-    pub(super) fn trace_and_sum(&self, h: &CameraHits, sh: &Shaded, out: &mut [Rgb; LANES]) {
+    pub(super) fn trace_and_sum<const SPHERES: bool>(
+        &self,
+        h: &CameraHits,
+        sh: &Shaded,
+        out: &mut [Rgb; LANES],
+    ) {
         let scene = self.scene;
         let s = &self.strategy;
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
@@ -365,8 +370,8 @@ impl Direct<'_> {
         let shadow = Scene::shadow_rays_to(&sh.shadow_o.axes(), &sh.shadow_target.axes(), &h.skip);
         let traced = h.covered & mask_of(&sh.light_ok);
         let blocked = scene.accel.occluded8(&shadow, traced);
-        // The BSDF rays, put through `bsdf_ray_hit`'s box reject in lanes: only those it lets
-        // through are traced, one by one.
+        // The BSDF rays, put through `bsdf_ray_hit`'s reject in lanes (without sphere lights,
+        // its box reject alone): only those it lets through are traced, one by one.
         let bsdf_rays = RayPacket {
             o: sh.bsdf_o.axes(),
             d: sh.bsdf_d.axes(),
@@ -376,7 +381,7 @@ impl Direct<'_> {
         };
         let open = h.covered & mask_of(&sh.bsdf_ok);
         let mut bsdf = V3x8::default();
-        for i in bits(scene.bsdf_rays_may_hit(&bsdf_rays, open)) {
+        for i in bits(scene.bsdf_rays_may_hit::<SPHERES>(&bsdf_rays, open)) {
             let ray = bsdf_rays.ray(i);
             if let Some(hit) = scene.bsdf_ray_hit_traced(&ray, h.emitter_skip[i]) {
                 let bs = BsdfSample {

@@ -60,7 +60,7 @@ impl Direct<'_> {
         out: &mut [Rgb; LANES],
     ) {
         let shaded = self.shade_rough(h, ld, sd, u);
-        self.trace_and_sum(h, &shaded, out);
+        self.trace_and_sum::<true>(h, &shaded, out);
     }
 
     #[inline(always)]

@@ -4,7 +4,8 @@
 
 use super::Scene;
 use crate::emitter::LightSampling;
-use crate::geometry::Hit;
+use crate::geometry::packet::PACKET;
+use crate::geometry::{Hit, RayPacket};
 use crate::rng::Rng;
 use crate::sampling::warps::square_to_uniform_sphere;
 
@@ -30,6 +31,8 @@ fn check(scene: &Scene, n: u32) -> (u32, u32) {
     let cam = &scene.camera;
     let mut rng = Rng::new(11, 5);
     let (mut from_surface, mut from_light) = (0, 0);
+    // Every ray, for the lane kernel's form of the query below.
+    let rays = std::cell::RefCell::new(Vec::new());
     let compare = |sp: &crate::geometry::SurfacePoint, d: glam::Vec3| {
         let (ray, skip) = scene.bsdf_ray(sp, d);
         let (fast, full) = (
@@ -37,6 +40,7 @@ fn check(scene: &Scene, n: u32) -> (u32, u32) {
             scene.intersect_emitter(&ray),
         );
         assert!(same(&fast, &full), "ray {ray:?}: {fast:?} vs {full:?}");
+        rays.borrow_mut().push((ray, skip, full));
         full.is_some() as u32
     };
     for _ in 0..n {
@@ -57,6 +61,38 @@ fn check(scene: &Scene, n: u32) -> (u32, u32) {
         if let Some(on_light) = scene.intersect(&scene.spawn_ray(&hit.sp, to_light)) {
             if scene.emitter_at(&on_light.sp).is_some() {
                 from_light += compare(&on_light.sp, square_to_uniform_sphere(rng.next_2d()));
+            }
+        }
+    }
+    // The lane kernel's form: eight rays' reject in lanes (`bsdf_rays_may_hit`), then
+    // `bsdf_ray_hit_traced` of each it lets through; lanes outside the mask hold rays too.
+    for (k, chunk) in rays.borrow().chunks(PACKET).enumerate() {
+        let mut packet = RayPacket::default();
+        chunk
+            .iter()
+            .enumerate()
+            .for_each(|(i, r)| packet.set(i, &r.0));
+        let active = ((1 << chunk.len()) - 1) & !(1 << (k % PACKET));
+        let (open, boxed) = (
+            scene.bsdf_rays_may_hit::<true>(&packet, active),
+            scene.bsdf_rays_may_hit::<false>(&packet, active),
+        );
+        assert_eq!(open & !active, 0, "lanes outside the mask let through");
+        assert_eq!(
+            open & !boxed,
+            0,
+            "the sphere test lets through what the box turns away"
+        );
+        for (i, (ray, skip, full)) in chunk.iter().enumerate() {
+            if active >> i & 1 != 0 {
+                let fast = match open >> i & 1 != 0 {
+                    true => scene.bsdf_ray_hit_traced(ray, *skip),
+                    false => None,
+                };
+                assert!(
+                    same(&fast, full),
+                    "lanes, ray {ray:?}: {fast:?} vs {full:?}"
+                );
             }
         }
     }
