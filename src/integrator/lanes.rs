@@ -23,7 +23,7 @@ use super::lane_tables::{LaneLight, LaneLightKind, LaneMaterial, LaneShape};
 use crate::bsdf::{BsdfSample, Diffuse};
 use crate::emitter::{area_pdf_along, sample_at, sphere_area_point};
 use crate::geometry::packet::bits;
-use crate::geometry::{Accel, Mesh, RayPacket, Sphere, SurfacePoint};
+use crate::geometry::{Accel, Mesh, PacketHits, RayPacket, Sphere, SurfacePoint};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
 use crate::sampling::warps::square_to_uniform_triangle;
@@ -42,6 +42,15 @@ pub(super) struct V3x8 {
 }
 
 impl V3x8 {
+    #[inline(always)]
+    fn splat(v: Vec3) -> Self {
+        V3x8 {
+            x: [v.x; LANES],
+            y: [v.y; LANES],
+            z: [v.z; LANES],
+        }
+    }
+
     #[inline(always)]
     pub(super) fn get(&self, i: usize) -> Vec3 {
         Vec3::new(self.x[i], self.y[i], self.z[i])
@@ -182,6 +191,11 @@ impl Direct<'_> {
             d: V3x8::from_axes(rays.d),
             ..CameraHits::default()
         };
+        if let Some(shape) = one_shape(shapes, &camera) {
+            if self.fill_one_shape(shape, &camera, rays, &mut h) {
+                return h;
+            }
+        }
         let mut batch = None;
         for i in 0..n {
             if camera.mask >> i & 1 == 0 {
@@ -225,6 +239,53 @@ impl Direct<'_> {
         }
         h.rough = batch == Some(true);
         h
+    }
+
+    /// `camera_hits`'s loop for hits that all lie on one shape (most pixels' eight samples):
+    /// its row read once for all lanes. False, with `h` untouched, for a material the lanes
+    /// do not cover.
+    #[inline(always)]
+    fn fill_one_shape(
+        &self,
+        shape: &LaneShape,
+        camera: &PacketHits,
+        rays: &RayPacket,
+        h: &mut CameraHits,
+    ) -> bool {
+        // Lanes without a hit take the row too: their samples are computed and dropped.
+        h.rough = match shape.material {
+            LaneMaterial::Diffuse(reflectance) => {
+                h.reflectance = V3x8::splat(reflectance);
+                false
+            }
+            LaneMaterial::Rough {
+                reflectance,
+                alpha,
+                eta_k,
+            } => {
+                h.reflectance = V3x8::splat(reflectance);
+                (h.alpha_u, h.alpha_v) = ([alpha.0; LANES], [alpha.1; LANES]);
+                (h.eta, h.k) = ([eta_k.0; LANES], [eta_k.1; LANES]);
+                true
+            }
+            LaneMaterial::Other => return false,
+        };
+        if !self.strategy.hide_emitters {
+            if let Some(e) = shape.emitter {
+                let emitter = &self.scene.emitters[e as usize];
+                for i in bits(camera.mask) {
+                    let mut l = Rgb::ZERO;
+                    l += emitter.le(&camera.point(i), -rays.d(i));
+                    h.le.set(i, l);
+                }
+            }
+        }
+        h.covered = camera.mask;
+        for i in 0..LANES {
+            h.skip[i] = Accel::skip_from(shape.skip_base, camera.prim[i]);
+            h.emitter_skip[i] = Accel::skip_from(shape.emitter_skip_base, camera.prim[i]);
+        }
+        true
     }
 
     /// Emitter and triangle choice and the triangle's data: the table lookups of `light_draw`.
@@ -408,6 +469,17 @@ impl Direct<'_> {
             out[i] = sum.get(i);
         }
     }
+}
+
+/// The shape every hit of the packet lies on, if there are hits and they share one.
+#[inline(always)]
+fn one_shape<'s>(shapes: &'s [LaneShape], camera: &PacketHits) -> Option<&'s LaneShape> {
+    let first = camera.shape[camera.mask.checked_ilog2()? as usize];
+    let mut same = 0u32;
+    for i in 0..LANES {
+        same |= ((camera.shape[i] == first) as u32) << i;
+    }
+    (same & camera.mask == camera.mask).then(|| &shapes[first as usize])
 }
 
 /// The lanes whose flag is set, as a mask.
