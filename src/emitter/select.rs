@@ -52,6 +52,13 @@ impl EmitterSelector {
         })
     }
 
+    /// With exactly one emitter, its pmf: `sample` then returns (0, this) for every u in
+    /// [0, 1) (a one-bin alias table keeps its bin).
+    #[inline]
+    pub fn single(&self) -> Option<f32> {
+        (self.count == 1).then(|| self.pmf(0))
+    }
+
     #[inline]
     pub fn pmf(&self, i: usize) -> f32 {
         match &self.table {
@@ -102,6 +109,34 @@ mod tests {
         // pi * A * L for area lights, 4 pi * luminance(I) for point lights.
         assert!((e[0].power() - std::f64::consts::PI * 0.01 * 100.0).abs() < 1e-4);
         assert_eq!(sel.pmf(2), 0.0);
+    }
+
+    /// `single` is `sample`'s answer for every u of one emitter, whatever its power, and
+    /// None for more (or none).
+    #[test]
+    fn single_is_what_sample_returns_for_one_emitter() {
+        let mut rng = Rng::new(8, 3);
+        let below_one = f32::from_bits(1.0f32.to_bits() - 1);
+        for (k, e) in emitters().into_iter().enumerate() {
+            for mode in [EmitterSelection::Uniform, EmitterSelection::Power] {
+                let sel = EmitterSelector::new(std::slice::from_ref(&e), mode);
+                let single = sel.single().unwrap();
+                for u in [0.0, 0.5, below_one]
+                    .into_iter()
+                    .chain((0..1000).map(|_| rng.next_f32()))
+                {
+                    assert_eq!(
+                        sel.sample(u),
+                        Some((0, single)),
+                        "emitter {k}, {mode:?}, u {u}"
+                    );
+                }
+            }
+        }
+        for mode in [EmitterSelection::Uniform, EmitterSelection::Power] {
+            assert_eq!(EmitterSelector::new(&emitters(), mode).single(), None);
+            assert_eq!(EmitterSelector::new(&[], mode).single(), None);
+        }
     }
 
     /// Chi-square of 1M choices against the pmf, alpha = 0.01, for both selection modes; and

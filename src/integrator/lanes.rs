@@ -19,7 +19,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::direct::{heuristic, Direct};
-use super::lane_tables::{LaneLight, LaneLightKind, LaneMaterial, LaneShape};
+use super::lane_tables::{LaneLight, LaneLightKind, LaneMaterial, LaneShape, LightTriangle};
 use crate::bsdf::{BsdfSample, Diffuse};
 use crate::emitter::{area_pdf_along, sample_at, sphere_area_point};
 use crate::geometry::packet::bits;
@@ -27,6 +27,7 @@ use crate::geometry::{Accel, Mesh, PacketHits, RayPacket, Sphere, SurfacePoint};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
 use crate::sampling::warps::square_to_uniform_triangle;
+use crate::sampling::AliasTable;
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 
@@ -122,6 +123,34 @@ pub(super) struct LightDraws {
     radiance: V3x8,
     area: [f32; LANES],
     pub(super) pmf: [f32; LANES],
+}
+
+impl LightDraws {
+    /// Lane i's triangle of a mesh light, drawn with `u`, and its record.
+    #[inline(always)]
+    fn triangle(
+        &mut self,
+        i: usize,
+        triangles: &AliasTable,
+        records: &[LightTriangle],
+        smooth: Option<&Mesh>,
+        u: f32,
+    ) {
+        let tri = triangles.sample(u);
+        let r = &records[tri];
+        for (k, v) in r.v.into_iter().enumerate() {
+            self.v[k].set(i, v);
+        }
+        if let Some(n) = smooth.and_then(|m| m.vertex_normals(tri)) {
+            for (k, n) in n.into_iter().enumerate() {
+                self.n[k].set(i, n);
+            }
+            self.has_normals[i] = true;
+        }
+        self.ng.set(i, r.ng);
+        self.err.set(i, r.err);
+        self.tri[i] = tri as u32;
+    }
 }
 
 /// The lanes' rays and candidate contributions, before visibility.
@@ -298,6 +327,25 @@ impl Direct<'_> {
         d: &mut LightDraws,
         spheres: &mut SphereDraws,
     ) {
+        if let Some(pmf) = self.selector.single() {
+            // Every lane draws the one emitter: its data is copied once.
+            let light = &lights[0];
+            d.shape = [light.shape; LANES];
+            d.radiance = V3x8::splat(light.radiance);
+            d.area = [light.area; LANES];
+            d.pmf = [pmf; LANES];
+            match &light.kind {
+                LaneLightKind::Mesh {
+                    triangles,
+                    records,
+                    smooth,
+                } => (0..LANES).for_each(|i| d.triangle(i, triangles, records, *smooth, u_tri[i])),
+                LaneLightKind::Sphere(sphere) => {
+                    (spheres.sphere, spheres.any) = ([Some(**sphere); LANES], true)
+                }
+            }
+            return;
+        }
         for i in 0..LANES {
             let Some((e, pmf)) = self.selector.sample(u_emitter[i]) else {
                 continue;
@@ -307,31 +355,16 @@ impl Direct<'_> {
             d.radiance.set(i, light.radiance);
             d.area[i] = light.area;
             d.pmf[i] = pmf;
-            let (triangles, records, smooth) = match &light.kind {
+            match &light.kind {
                 LaneLightKind::Mesh {
                     triangles,
                     records,
                     smooth,
-                } => (triangles, records, smooth),
+                } => d.triangle(i, triangles, records, *smooth, u_tri[i]),
                 LaneLightKind::Sphere(sphere) => {
                     (spheres.sphere[i], spheres.any) = (Some(**sphere), true);
-                    continue;
                 }
-            };
-            let tri = triangles.sample(u_tri[i]);
-            let r = &records[tri];
-            for (k, v) in r.v.into_iter().enumerate() {
-                d.v[k].set(i, v);
             }
-            if let Some(n) = smooth.and_then(|m| m.vertex_normals(tri)) {
-                for (k, n) in n.into_iter().enumerate() {
-                    d.n[k].set(i, n);
-                }
-                d.has_normals[i] = true;
-            }
-            d.ng.set(i, r.ng);
-            d.err.set(i, r.err);
-            d.tri[i] = tri as u32;
         }
     }
 
