@@ -60,6 +60,15 @@ pub(super) fn slab_inv(d: Vec3) -> Vec3A {
     (Vec3A::ONE / Vec3A::from(d)).clamp(Vec3A::splat(-f32::MAX), Vec3A::splat(f32::MAX))
 }
 
+/// `slab_inv` of one axis of eight directions, in lanes: the same IEEE operations per lane.
+#[inline(always)]
+pub(super) fn slab_inv8(d: &[f32; 8]) -> F8 {
+    F8::splat(1.0)
+        .div(F8::load(d))
+        .max(F8::splat(-f32::MAX))
+        .min(F8::splat(f32::MAX))
+}
+
 /// Index into `Node::b` of each axis's near plane for a ray with slab inverse `inv`: the
 /// min plane where the direction is positive, the max plane where it is negative.
 #[inline(always)]
@@ -200,10 +209,7 @@ impl WideBvh {
     ) -> u32 {
         let (mut tn, mut tf) = (F8::load(tmin), F8::load(tmax));
         for a in 0..3 {
-            let inv = F8::splat(1.0)
-                .div(F8::load(&d[a]))
-                .max(F8::splat(-f32::MAX))
-                .min(F8::splat(f32::MAX));
+            let inv = slab_inv8(&d[a]);
             let o = F8::load(&o[a]);
             let t0 = F8::splat(self.bounds.0[a]).sub(o).mul(inv);
             let t1 = F8::splat(self.bounds.1[a]).sub(o).mul(inv);

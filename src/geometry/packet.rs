@@ -11,7 +11,7 @@
 //! leaves) may be visited in another order and resolved the other way, as by any other BVH.
 
 use super::accel::{surface_point, Accel};
-use super::bvh::{push_by_distance, read, slab_test, Node, WideBvh};
+use super::bvh::{push_by_distance, read, slab_inv8, slab_test, Node, WideBvh};
 use super::bvh::{LEAF, ROBUST, STACK};
 use super::lanes8::{F8, M8};
 use super::ray_packet::{PacketHits, RayPacket};
@@ -68,10 +68,7 @@ impl Boxes {
             tmin: *tmin,
         };
         for (a, d) in d.iter().enumerate() {
-            let inv = F8::splat(1.0)
-                .div(F8::load(d))
-                .max(F8::splat(-f32::MAX))
-                .min(F8::splat(f32::MAX));
+            let inv = slab_inv8(d);
             inv.store(&mut b.inv[a]);
             b.neg[a] = inv.sign_mask();
         }
