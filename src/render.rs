@@ -2,7 +2,7 @@
 //! so the image is bitwise identical for any thread count.
 
 use crate::film::Image;
-use crate::integrator::{Direct, Strategy};
+use crate::integrator::{Direct, LaneScratch, Strategy};
 use crate::rng::{Rng, RngLanes, LANES};
 use crate::scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -100,7 +100,13 @@ fn is_finite(v: glam::Vec3) -> bool {
     (v.x - v.x) + (v.y - v.y) + (v.z - v.z) == 0.0
 }
 
-fn render_pixel(direct: &Direct, x: u32, y: u32, settings: &RenderSettings) -> PixelResult {
+fn render_pixel(
+    direct: &Direct,
+    x: u32,
+    y: u32,
+    settings: &RenderSettings,
+    scratch: &mut LaneScratch,
+) -> PixelResult {
     let cam = &direct.scene.camera;
     let pixel = y as u64 * cam.width as u64 + x as u64;
     let mut stats = PixelStats::default();
@@ -114,7 +120,7 @@ fn render_pixel(direct: &Direct, x: u32, y: u32, settings: &RenderSettings) -> P
         let mut lanes = RngLanes::for_pixel_samples(key, s0 as u64);
         let rays = cam.generate_rays(x, y, &mut lanes);
         let n = (settings.spp - s0).min(LANES as u32) as usize;
-        let values = direct.li_lanes(&rays, n, &mut lanes);
+        let values = direct.li_lanes(&rays, n, &mut lanes, scratch);
         for mut v in values.into_iter().take(n) {
             if !is_finite(v) {
                 // Counted and reported; a correct estimator never gets here (tests assert 0).
@@ -166,9 +172,11 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
             .map(|&(x0, y0)| {
                 let tile_start = Instant::now();
                 let mut out = Vec::with_capacity((TILE * TILE) as usize);
+                let mut scratch = LaneScratch::default();
                 for y in y0..(y0 + TILE).min(h) {
                     for x in x0..(x0 + TILE).min(w) {
-                        out.push((x, y, render_pixel(&direct, x, y, settings)));
+                        let r = render_pixel(&direct, x, y, settings, &mut scratch);
+                        out.push((x, y, r));
                     }
                 }
                 bar.inc(1);

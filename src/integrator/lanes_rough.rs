@@ -57,10 +57,11 @@ impl Direct<'_> {
         ld: &LightDraws,
         sd: &SphereDraws,
         u: &[[f32; LANES]; 7],
+        shaded: &mut Shaded,
         out: &mut [Rgb; LANES],
     ) {
-        let shaded = self.shade_rough(h, ld, sd, u);
-        self.trace_and_sum::<true>(h, &shaded, out);
+        self.shade_rough(h, ld, sd, u, shaded);
+        self.trace_and_sum::<true>(h, shaded, out);
     }
 
     #[inline(always)]
@@ -70,10 +71,10 @@ impl Direct<'_> {
         ld: &LightDraws,
         sd: &SphereDraws,
         u: &[[f32; LANES]; 7],
-    ) -> Shaded {
+        o: &mut Shaded,
+    ) {
         let s = &self.strategy;
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
-        let mut o = Shaded::default();
         let mut wi_local = V3x8::default();
         let mut lambda_i = [0.0f32; LANES];
         for i in 0..LANES {
@@ -148,7 +149,6 @@ impl Direct<'_> {
             o.bsdf_d.set(i, d);
             o.bsdf_o.set(i, offset_origin(p, ng, err, d));
         }
-        o
     }
 }
 
@@ -236,10 +236,11 @@ mod tests {
         let mut rays = RayPacket::splat(&away);
         (0..4).for_each(|i| rays.set(i, &plate));
         let batches = 64;
+        let mut scratch = crate::integrator::LaneScratch::default();
         ITERS.with(|c| c.set(0));
         for b in 0..batches {
             let mut lanes = RngLanes::for_pixel_samples(9, 8 * b);
-            direct.li_lanes(&rays, LANES, &mut lanes);
+            direct.li_lanes(&rays, LANES, &mut lanes, &mut scratch);
         }
         let per_batch = ITERS.with(|c| c.get()) as f64 / batches as f64;
         // The four plate lanes need a fourth step about 4 % of the time.

@@ -7,6 +7,7 @@ mod lanes_rough;
 mod strategy;
 
 pub use direct::Direct;
+pub use lanes::LaneScratch;
 pub use strategy::Strategy;
 
 #[cfg(test)]
