@@ -119,6 +119,7 @@ pub const LANES: usize = 8;
 /// `LANES` per-sample generators stepped together, lane i being `for_pixel_sample(key, s0 + i)`.
 /// Plain loops over arrays, which the compiler turns into vector instructions: the seeding
 /// (64-bit multiplications) and the camera's draws cost about an eighth.
+#[derive(Clone)]
 pub struct RngLanes {
     state: [u64; LANES],
     /// The pixel's stream, shared by its samples.
