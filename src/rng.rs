@@ -16,19 +16,6 @@ pub fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// PCG32's output permutation (XSH RR) of a state.
-#[inline(always)]
-fn output(state: u64) -> u32 {
-    let xorshifted = (((state >> 18) ^ state) >> 27) as u32;
-    let rot = (state >> 59) as u32;
-    xorshifted.rotate_right(rot)
-}
-
-#[inline(always)]
-fn to_f32(x: u32) -> f32 {
-    (x >> 8) as f32 * (1.0 / 16_777_216.0)
-}
-
 /// PCG32 (XSH RR), O'Neill 2014.
 #[derive(Clone, Debug)]
 pub struct Rng {
@@ -90,13 +77,15 @@ impl Rng {
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;
         self.state = old.wrapping_mul(PCG_MULT).wrapping_add(self.inc);
-        output(old)
+        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+        let rot = (old >> 59) as u32;
+        xorshifted.rotate_right(rot)
     }
 
     /// Uniform in [0, 1), never 1: 24 random mantissa bits.
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
-        to_f32(self.next_u32())
+        (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
     }
 
     /// Uniform in [0, 1) with 53 random bits, for statistics code.
