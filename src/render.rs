@@ -375,8 +375,21 @@ mod tests {
                 }
             }
         };
+        // Rougher plates, seen at grazing angles: their slope inversions need the lanes'
+        // extra step after the fixed ones, and some the scalar `finish`.
+        let rough_plates = |d: &mut SceneDesc| {
+            use crate::scene::desc::BsdfDesc;
+            for shape in &mut d.shapes {
+                if let BsdfDesc::RoughConductor {
+                    alpha_u, alpha_v, ..
+                } = &mut shape.bsdf
+                {
+                    (*alpha_u, *alpha_v) = (0.4, 0.4);
+                }
+            }
+        };
         type Edit = dyn Fn(&mut SceneDesc);
-        let cases: [(&str, &Edit, crate::integrator::Strategy, bool); 8] = [
+        let cases: [(&str, &Edit, crate::integrator::Strategy, bool); 9] = [
             ("cbox/cbox.xml", &keep, mis, true),
             // A light mesh of many triangles: the lanes' per-triangle records.
             ("cbox-meshlight/cbox-meshlight.xml", &keep, power, true),
@@ -406,6 +419,7 @@ mod tests {
             ),
             ("cbox-materials/cbox-materials.xml", &keep, power, false),
             ("veach-mis/veach-mis.xml", &tent, mis, true),
+            ("veach-mis/veach-mis.xml", &rough_plates, power, true),
         ];
         for (rel, edit, strategy, lanes) in cases {
             let mut desc = crate::scene::bundled_tests::load(rel);

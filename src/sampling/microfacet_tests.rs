@@ -169,9 +169,10 @@ fn samplers_match_their_pdfs_chi2() {
     );
 }
 
-/// Cost guard: the Beckmann visible-slope inversion converges in a few Newton steps.
+/// Cost guard: the Beckmann visible-slope inversion converges in a few Halley steps, fewer
+/// than three on average from normal to grazing incidence (Newton's steps took 3.0 to 3.4).
 #[test]
-fn beckmann_newton_iterations() {
+fn beckmann_slope_steps() {
     let mf = Microfacet::new(MicrofacetDistribution::Beckmann, 0.1, 0.1);
     let mut rng = crate::rng::Rng::new(1, 1);
     for c in [1.0f32, 0.7, 0.3, 0.01] {
@@ -181,8 +182,8 @@ fn beckmann_newton_iterations() {
             mf.sample_visible(wi, rng.next_2d());
         }
         let per = ITERS.with(|i| i.get()) as f64 / 1e4;
-        eprintln!("cos {c}: {per} Newton iterations per sample");
-        assert!(per < 4.0, "{per}");
+        eprintln!("cos {c}: {per} slope steps per sample");
+        assert!(per < 3.0, "{per}");
     }
 }
 
