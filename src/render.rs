@@ -375,8 +375,8 @@ mod tests {
                 }
             }
         };
-        // Rougher plates, seen at grazing angles: their slope inversions need the lanes'
-        // extra step after the fixed ones, and some the scalar `finish`.
+        // Rougher plates, seen at grazing angles: their slope inversions need the
+        // lanes' extra vector step after the fixed ones.
         let rough_plates = |d: &mut SceneDesc| {
             use crate::scene::desc::BsdfDesc;
             for shape in &mut d.shapes {

@@ -3,7 +3,7 @@
 //!
 //! Each pass is a loop over the eight lanes that calls the scalar code of `li`'s path in the
 //! same order: `RoughConductor::eval_pdf_with` for the light sample; then the visible-normal
-//! sampler in its parts (`beckmann_visible_begin`, the slope inversion's fixed Newton steps,
+//! sampler in its parts (`beckmann_visible_begin`, the slope inversion's fixed Halley steps,
 //! the steps some lanes still need, `beckmann_visible_end`) and `RoughConductor::reflect`.
 //! The parts without branches run in vector lanes; the samples stay bitwise `li`'s.
 
@@ -230,7 +230,7 @@ mod tests {
     use glam::Vec3;
 
     /// Cost guard: in a batch of rough-conductor hits, lanes without a covered hit (rays
-    /// that leave the scene) take no Newton steps past the fixed ones. Their inversions are
+    /// that leave the scene) take no slope steps past the fixed ones. Their inversions are
     /// garbage (NaN), which used to bisect to the 64-step limit: 61 steps per empty lane.
     #[test]
     fn empty_lanes_of_a_rough_batch_take_no_further_steps() {

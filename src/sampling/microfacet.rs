@@ -178,7 +178,7 @@ impl Microfacet {
         self.beckmann_visible_end(&b)
     }
 
-    /// `sample_visible_beckmann` up to the slope inversion's Newton steps. Its three parts
+    /// `sample_visible_beckmann` up to the slope inversion's steps. Its three parts
     /// are separate functions for the lane kernel, which runs each in a loop of its own.
     #[inline(always)]
     pub(crate) fn beckmann_visible_begin(&self, wi: Vec3, u: Vec2) -> BeckmannVisible {
@@ -233,7 +233,7 @@ pub(crate) struct BeckmannVisible {
     pub slope: SlopeInversion,
 }
 
-// Newton iterations of the slope inversion, counted for the cost test.
+// Steps of the slope inversion, counted for the cost test.
 #[cfg(test)]
 thread_local!(pub static ITERS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) });
 
@@ -335,7 +335,7 @@ pub(crate) fn slope_step(
 ) -> (f64, f64, f64, bool) {
     let e = exp(-x * x);
     let f = erfc_from_exp(-x, e) + k * e - target;
-    // f = 0 leaves the bracket as it is: x is then a root, and the Newton step to x itself
+    // f = 0 leaves the bracket as it is: x is then a root, and the step to x itself
     // must stay inside.
     let hi = if f > 0.0 { x } else { hi };
     let lo = if f < 0.0 { x } else { lo };
