@@ -330,6 +330,13 @@ mod tests {
             mean.iter().all(|&m| (m - 8.0 / 6.0).abs() < 1e-15),
             "{mean:?}"
         );
+        // A batch whose only non-finite value is an infinity (the smallest non-finite
+        // magnitude) is caught as well.
+        for inf in [f32::INFINITY, f32::NEG_INFINITY] {
+            let mut v = [Vec3::splat(2.0); LANES];
+            v[3].z = inf;
+            assert_eq!(PixelStats::default().push_batch(&v, LANES), 1);
+        }
         assert_eq!(PixelStats::default().finish(), ([0.0; 3], [0.0; 3]));
     }
 
