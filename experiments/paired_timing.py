@@ -51,8 +51,9 @@ def main():
     ap.add_argument("--pairs", type=int, default=16)
     ap.add_argument("--scene", choices=sorted(SCENES), default="cbox")
     argv = sys.argv[1:]
-    extra = argv[argv.index("--") + 1 :] if "--" in argv else []
-    a = ap.parse_args(argv[: len(argv) - len(extra) - (1 if extra or "--" in argv else 0)])
+    cut = argv.index("--") if "--" in argv else len(argv)
+    a = ap.parse_args(argv[:cut])
+    extra = argv[cut + 1 :]
     for binary in (a.a, a.b):
         if not (os.path.isfile(binary) and os.access(binary, os.X_OK)):
             sys.exit(f"{binary}: not an executable file (expected a directlab binary)")

@@ -116,32 +116,17 @@ impl Direct<'_> {
             (vis.target[i], vis.k[i]) = (b.target, b.k);
         }
         for _ in 0..SlopeInversion::FIXED_STEPS {
-            for i in 0..LANES {
-                let v = &mut vis;
-                (v.x[i], v.lo[i], v.hi[i], v.done[i]) =
-                    slope_step(v.x[i], v.lo[i], v.hi[i], v.target[i], v.tan_t[i], v.k[i]);
-            }
+            vis.step(false);
         }
         // Lanes without a covered hit hold garbage (NaN), which would bisect to the 64-step
         // limit: their samples are dropped, so they take no more steps.
         let short = |v: &VisibleX8, i: usize| !v.done[i] && h.covered >> i & 1 != 0;
-        // One more step in vector lanes, where any lane needs it; lanes already converged
-        // keep their point (`finish` would not step them).
+        // One more step in vector lanes, where any lane needs it.
         let taken = if (0..LANES).any(|i| short(&vis, i)) {
-            for i in 0..LANES {
-                #[cfg(test)]
-                if short(&vis, i) {
-                    crate::sampling::microfacet::ITERS.with(|c| c.set(c.get() + 1));
-                }
-                let v = &mut vis;
-                let (x, lo, hi, done) =
-                    slope_step(v.x[i], v.lo[i], v.hi[i], v.target[i], v.tan_t[i], v.k[i]);
-                let keep = v.done[i];
-                v.x[i] = if keep { v.x[i] } else { x };
-                v.lo[i] = if keep { v.lo[i] } else { lo };
-                v.hi[i] = if keep { v.hi[i] } else { hi };
-                v.done[i] = keep || done;
-            }
+            #[cfg(test)]
+            crate::sampling::microfacet::ITERS
+                .with(|c| c.set(c.get() + (0..LANES).filter(|&i| short(&vis, i)).count() as u64));
+            vis.step(true);
             SlopeInversion::FIXED_STEPS + 1
         } else {
             SlopeInversion::FIXED_STEPS
@@ -191,6 +176,27 @@ struct VisibleX8 {
 }
 
 impl VisibleX8 {
+    /// One slope step in every lane. With `keep_converged`, lanes whose last step converged
+    /// keep their point, as `SlopeInversion::finish` would leave them.
+    #[inline(always)]
+    fn step(&mut self, keep_converged: bool) {
+        for i in 0..LANES {
+            let (x, lo, hi, done) = slope_step(
+                self.x[i],
+                self.lo[i],
+                self.hi[i],
+                self.target[i],
+                self.tan_t[i],
+                self.k[i],
+            );
+            let keep = keep_converged && self.done[i];
+            self.x[i] = if keep { self.x[i] } else { x };
+            self.lo[i] = if keep { self.lo[i] } else { lo };
+            self.hi[i] = if keep { self.hi[i] } else { hi };
+            self.done[i] = keep || done;
+        }
+    }
+
     #[inline(always)]
     fn set(&mut self, i: usize, b: BeckmannVisible) {
         (self.cos_phi[i], self.sin_phi[i], self.y[i]) = (b.cos_phi, b.sin_phi, b.y);
