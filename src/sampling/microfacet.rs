@@ -171,10 +171,7 @@ impl Microfacet {
     /// and unstretch.
     fn sample_visible_beckmann(&self, wi: Vec3, u: Vec2) -> Vec3 {
         let mut b = self.beckmann_visible_begin(wi, u);
-        for _ in 0..SlopeInversion::FIXED_STEPS {
-            b.slope.step();
-        }
-        b.slope.finish(SlopeInversion::FIXED_STEPS);
+        b.slope.solve();
         self.beckmann_visible_end(&b)
     }
 
@@ -310,6 +307,15 @@ impl SlopeInversion {
         (self.x, self.lo, self.hi, self.done) = (x, lo, hi, done);
     }
 
+    /// The fixed steps, then `finish`: the scalar path's whole inversion.
+    #[inline]
+    pub fn solve(&mut self) {
+        for _ in 0..Self::FIXED_STEPS {
+            self.step();
+        }
+        self.finish(Self::FIXED_STEPS);
+    }
+
     /// Steps after the `taken` ones, while the last did not converge (at most 64 in all).
     #[inline]
     pub fn finish(&mut self, taken: usize) {
@@ -356,10 +362,7 @@ pub(crate) fn slope_step(
 #[cfg(test)]
 fn beckmann_visible_slope(tan_t: f64, u: f64) -> f64 {
     let mut s = SlopeInversion::new(tan_t, u);
-    for _ in 0..SlopeInversion::FIXED_STEPS {
-        s.step();
-    }
-    s.finish(SlopeInversion::FIXED_STEPS);
+    s.solve();
     s.x
 }
 
