@@ -111,7 +111,7 @@ impl Direct<'_> {
             (vis.cos_phi[i], vis.sin_phi[i], vis.tan_t[i]) = (cos_phi, sin_phi, tan_t);
         }
         for i in 0..LANES {
-            let b = SlopeInversion::new(vis.tan_t[i], u[5][i] as f64);
+            let b = SlopeInversion::new(vis.tan_t[i], u[5][i]);
             (vis.x[i], vis.lo[i], vis.hi[i], vis.done[i]) = (b.x, b.lo, b.hi, b.done);
             (vis.target[i], vis.k[i]) = (b.target, b.k);
         }
@@ -163,15 +163,15 @@ impl Direct<'_> {
 /// lanes, which they did not over an array of the structures.
 #[derive(Default)]
 struct VisibleX8 {
-    cos_phi: [f64; LANES],
-    sin_phi: [f64; LANES],
-    y: [f64; LANES],
-    x: [f64; LANES],
-    lo: [f64; LANES],
-    hi: [f64; LANES],
-    target: [f64; LANES],
-    tan_t: [f64; LANES],
-    k: [f64; LANES],
+    cos_phi: [f32; LANES],
+    sin_phi: [f32; LANES],
+    y: [f32; LANES],
+    x: [f32; LANES],
+    lo: [f32; LANES],
+    hi: [f32; LANES],
+    target: [f32; LANES],
+    tan_t: [f32; LANES],
+    k: [f32; LANES],
     done: [bool; LANES],
 }
 

@@ -11,12 +11,12 @@
 //! the slope density P22(x, y) dx dy; stretching slopes by (alpha_u, alpha_v) gives anisotropy.
 
 use super::elementary::{atan, exp, ln};
-use super::erf::{erfc_from_exp, erfinv, erfinv_approx};
+use super::erf::{erfc_from_exp, erfinv};
 pub use crate::scene::desc::MicrofacetDistribution;
 use glam::{DVec3, Vec2, Vec3};
-use std::f64::consts::{FRAC_2_SQRT_PI, PI};
+use std::f32::consts::{FRAC_2_SQRT_PI, PI};
 
-const SQRT_PI: f64 = 1.772_453_850_905_516;
+const SQRT_PI: f32 = 1.772_453_9;
 
 /// Below this roughness f32 evaluation of D loses its peak (Mitsuba clamps at the same value).
 pub const MIN_ALPHA: f32 = 1e-4;
@@ -40,11 +40,11 @@ impl Microfacet {
     /// Normal distribution D(m), zero for normals facing down.
     #[inline(always)]
     pub fn d(&self, m: Vec3) -> f32 {
-        let up = m.z > 0.0;
-        let m = m.as_dvec3();
-        let (au, av) = (self.alpha_u as f64, self.alpha_v as f64);
+        let (au, av) = (self.alpha_u, self.alpha_v);
         let (x, y) = (m.x / au, m.y / av);
         let z2 = m.z * m.z;
+        // z^4 is 0 for |z| below ~1e-11, where Beckmann's exp is 0 as well: no 0 / 0.
+        let up = m.z > 0.0 && z2 * z2 > 0.0;
         let d = match self.distribution {
             MicrofacetDistribution::Beckmann => {
                 exp(-(x * x + y * y) / z2) / (PI * au * av * z2 * z2)
@@ -56,7 +56,7 @@ impl Microfacet {
         };
         // A select, not an early return: `integrator::lanes` runs this in vector lanes.
         if up {
-            d as f32
+            d
         } else {
             0.0
         }
@@ -65,8 +65,7 @@ impl Microfacet {
     /// Smith's Lambda for direction w (independent of the microfacet normal).
     #[inline(always)]
     pub fn lambda(&self, w: Vec3) -> f32 {
-        let w = w.as_dvec3();
-        let (au, av) = (self.alpha_u as f64, self.alpha_v as f64);
+        let (au, av) = (self.alpha_u, self.alpha_v);
         // alpha(w)^2 tan^2(theta_w), the squared slope scale seen from w.
         let a2t2 = ((w.x * au).powi(2) + (w.y * av).powi(2)) / (w.z * w.z);
         let l = match self.distribution {
@@ -84,7 +83,7 @@ impl Microfacet {
             }
         };
         if a2t2.is_finite() {
-            l.max(0.0) as f32
+            l.max(0.0)
         } else {
             f32::INFINITY
         }
@@ -115,7 +114,7 @@ impl Microfacet {
             MicrofacetDistribution::Beckmann => (-(1.0 - u0).ln()).sqrt(),
             MicrofacetDistribution::Ggx => (u0 / (1.0 - u0)).sqrt(),
         };
-        let (s, c) = (2.0 * PI * u1).sin_cos();
+        let (s, c) = (2.0 * std::f64::consts::PI * u1).sin_cos();
         let x = r * c * self.alpha_u as f64;
         let y = r * s * self.alpha_v as f64;
         DVec3::new(-x, -y, 1.0).normalize().as_vec3()
@@ -156,7 +155,7 @@ impl Microfacet {
         };
         let t2 = vh.cross(t1);
         let r = (u.x as f64).sqrt();
-        let (s, c) = (2.0 * PI * u.y as f64).sin_cos();
+        let (s, c) = (2.0 * std::f64::consts::PI * u.y as f64).sin_cos();
         let p1 = r * c;
         let h = 0.5 * (1.0 + vh.z);
         let p2 = (1.0 - h) * (1.0 - p1 * p1).max(0.0).sqrt() + h * r * s;
@@ -184,16 +183,15 @@ impl Microfacet {
             cos_phi,
             sin_phi,
             y: beckmann_visible_y(u.y),
-            slope: SlopeInversion::new(tan_t, u.x as f64),
+            slope: SlopeInversion::new(tan_t, u.x),
         }
     }
 
     /// wi's azimuth (cos, sin) and tan(theta) in the stretched configuration.
     #[inline(always)]
-    pub(crate) fn beckmann_visible_azimuth(&self, wi: Vec3) -> (f64, f64, f64) {
-        let (au, av) = (self.alpha_u as f64, self.alpha_v as f64);
-        let wi = wi.as_dvec3();
-        let ws = DVec3::new(au * wi.x, av * wi.y, wi.z).normalize();
+    pub(crate) fn beckmann_visible_azimuth(&self, wi: Vec3) -> (f32, f32, f32) {
+        let (au, av) = (self.alpha_u, self.alpha_v);
+        let ws = Vec3::new(au * wi.x, av * wi.y, wi.z).normalize();
         let sin_t = (ws.x * ws.x + ws.y * ws.y).sqrt();
         let tan_t = sin_t / ws.z;
         let has_azimuth = sin_t > 0.0;
@@ -205,18 +203,18 @@ impl Microfacet {
     /// `sample_visible_beckmann` after the slope inversion: rotate back and unstretch.
     #[inline(always)]
     pub(crate) fn beckmann_visible_end(&self, b: &BeckmannVisible) -> Vec3 {
-        let (au, av) = (self.alpha_u as f64, self.alpha_v as f64);
+        let (au, av) = (self.alpha_u, self.alpha_v);
         let (x, y) = (b.slope.x, b.y);
         let sx = (b.cos_phi * x - b.sin_phi * y) * au;
         let sy = (b.sin_phi * x + b.cos_phi * y) * av;
-        DVec3::new(-sx, -sy, 1.0).normalize().as_vec3()
+        Vec3::new(-sx, -sy, 1.0).normalize()
     }
 }
 
 /// The visible slope y, whose marginal is Gaussian (variance 1/2): a plain inverse erf.
 #[inline(always)]
-pub(crate) fn beckmann_visible_y(u: f32) -> f64 {
-    erfinv(2.0 * (u as f64).clamp(1e-12, 1.0 - 1e-12) - 1.0)
+pub(crate) fn beckmann_visible_y(u: f32) -> f32 {
+    erfinv(2.0 * u - 1.0)
 }
 
 /// A Beckmann visible-normal sample between `beckmann_visible_begin` and `_end`: the
@@ -224,9 +222,9 @@ pub(crate) fn beckmann_visible_y(u: f32) -> f64 {
 /// of the slope x.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct BeckmannVisible {
-    pub cos_phi: f64,
-    pub sin_phi: f64,
-    pub y: f64,
+    pub cos_phi: f32,
+    pub sin_phi: f32,
+    pub y: f32,
     pub slope: SlopeInversion,
 }
 
@@ -238,20 +236,23 @@ thread_local!(pub static ITERS: std::cell::Cell<u64> = const { std::cell::Cell::
 /// seen at tan(theta) = `tan_t` along +x. The density is proportional to
 /// exp(-x^2) (cot(theta) - x) on x < cot(theta); its CDF, times 2 / (sqrt(pi) cot(theta)), is
 ///   C(x) = erfc(-x) + tan(theta) / sqrt(pi) exp(-x^2).
-/// Safeguarded Halley steps (bisection fallback) from Mitsuba 3's starting guess. Every
-/// inversion takes `FIXED_STEPS` steps, then more only until a step is below 1e-6 (Halley
-/// converges cubically there, so the point is ~1e-12 from the root or closer, far finer than
-/// the f32 normal it feeds). The fixed steps have no branches: `integrator::lanes` runs them for
-/// eight samples in vector lanes, and the scalar path runs the same steps.
+/// Safeguarded Halley steps (bisection fallback) from Mitsuba 3's starting guess, in f32 as
+/// Mitsuba's. Every inversion takes `FIXED_STEPS` steps, then more only until a step is below
+/// 1e-5 (1 + |x|) (Halley converges cubically, so the point is then as close as f32 can
+/// place it), the CDF's residual is within its f32 rounding, or the bracket is a few ulps
+/// wide. The result is the exact inverse to within 4 ulps of x or 4 eps of u
+/// (`beckmann_slope_inversion_matches_bisection`): as fine as the f32 uniform number that
+/// drives it. The fixed steps have no branches: `integrator::lanes` runs them for eight
+/// samples in vector lanes, and the scalar path runs the same steps.
 #[derive(Clone, Copy, Default)]
 pub(crate) struct SlopeInversion {
     /// The current point, inside the bracket (lo, hi) around the root.
-    pub x: f64,
-    pub lo: f64,
-    pub hi: f64,
-    pub target: f64,
-    pub tan_t: f64,
-    pub k: f64,
+    pub x: f32,
+    pub lo: f32,
+    pub hi: f32,
+    pub target: f32,
+    pub tan_t: f32,
+    pub k: f32,
     /// Whether the last step converged.
     pub done: bool,
 }
@@ -261,7 +262,7 @@ impl SlopeInversion {
     pub const FIXED_STEPS: usize = 2;
 
     #[inline(always)]
-    pub fn new(tan_t: f64, u: f64) -> Self {
+    pub fn new(tan_t: f32, u: f32) -> Self {
         let k = tan_t / SQRT_PI;
         // Beyond |x| = 9 both terms are below 1e-35 of the total: nothing left to sample.
         let cot_t = 1.0 / tan_t;
@@ -270,15 +271,15 @@ impl SlopeInversion {
         // hi > 0, so erfc(-hi) is exactly 2 - erfc(hi) (that is how `erfc` makes it).
         let e_hi = exp(-hi * hi);
         let erfc_hi = erfc_from_exp(hi, e_hi);
-        let target = u.clamp(1e-12, 1.0 - 1e-12) * ((2.0 - erfc_hi) + k * e_hi);
+        let target = u * ((2.0 - erfc_hi) + k * e_hi);
         // Mitsuba 3's starting guess, in erf space: a power of 1 - u fitted in theta.
         let c = 1.0 - erfc_hi;
         let theta = atan(tan_t);
         let fit = 1.0 + theta * (-0.876 + theta * (0.4265 - 0.0594 * theta));
         let guess = c - (1.0 + c) * exp(fit * ln((1.0 - u).max(0.0)));
-        // `clamp` by hand: `f64::clamp` asserts lo <= hi, a panic path that kept this loop
+        // `clamp` by hand: `f32::clamp` asserts lo <= hi, a panic path that kept this loop
         // out of vector lanes in the lane kernel.
-        let g = erfinv_approx(guess);
+        let g = erfinv(guess);
         let x = if g < lo {
             lo
         } else if g > hi {
@@ -332,13 +333,13 @@ impl SlopeInversion {
 /// eight inversions: returns the new point, bracket and whether the step converged.
 #[inline(always)]
 pub(crate) fn slope_step(
-    x: f64,
-    lo: f64,
-    hi: f64,
-    target: f64,
-    tan_t: f64,
-    k: f64,
-) -> (f64, f64, f64, bool) {
+    x: f32,
+    lo: f32,
+    hi: f32,
+    target: f32,
+    tan_t: f32,
+    k: f32,
+) -> (f32, f32, f32, bool) {
     let e = exp(-x * x);
     let f = erfc_from_exp(-x, e) + k * e - target;
     // f = 0 leaves the bracket as it is: x is then a root, and the step to x itself
@@ -354,13 +355,17 @@ pub(crate) fn slope_step(
     // update may just have made an end.
     let inside = halley >= lo && halley <= hi;
     let next = if inside { halley } else { 0.5 * (lo + hi) };
-    let done = (inside && (next - x).abs() < 1e-6 * (1.0 + x.abs())) || hi - lo < 1e-12;
+    // Near the top of the CDF (C ~ 2) f carries an absolute rounding error of ~1e-7, so a
+    // tail root's steps never get below the first bound: the second and third stop them.
+    let done = (inside && (next - x).abs() < 1e-5 * (1.0 + x.abs()))
+        || f.abs() <= 4.0 * f32::EPSILON * target
+        || hi - lo < 4e-6 * (1.0 + x.abs());
     (next, lo, hi, done)
 }
 
 /// `SlopeInversion` from start to root.
 #[cfg(test)]
-fn beckmann_visible_slope(tan_t: f64, u: f64) -> f64 {
+fn beckmann_visible_slope(tan_t: f32, u: f32) -> f32 {
     let mut s = SlopeInversion::new(tan_t, u);
     s.solve();
     s.x
