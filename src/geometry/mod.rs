@@ -12,6 +12,7 @@ pub mod watertight;
 mod watertight8;
 
 pub use accel::Accel;
+pub use lanes8::lookup8;
 pub use ray_packet::{PacketHits, RayPacket};
 pub use shape::{Mesh, Shape, ShapeKind, Sphere};
 

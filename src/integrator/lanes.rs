@@ -19,11 +19,13 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::direct::{heuristic, Direct};
-use super::lane_tables::{LaneLight, LaneLightKind, LaneMaterial, LaneShape, LightTriangle};
+use super::lane_tables::{
+    LaneLight, LaneLightKind, LaneMaterial, LaneShape, LightTriangle, SmallMesh,
+};
 use crate::bsdf::{BsdfSample, Diffuse};
 use crate::emitter::{area_pdf_along, sample_at, sphere_area_point};
 use crate::geometry::packet::bits;
-use crate::geometry::{Accel, Mesh, PacketHits, RayPacket, Sphere, SurfacePoint};
+use crate::geometry::{lookup8, Accel, Mesh, PacketHits, RayPacket, Sphere, SurfacePoint};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
 use crate::sampling::warps::square_to_uniform_triangle;
@@ -150,6 +152,50 @@ impl LightDraws {
         self.ng.set(i, r.ng);
         self.err.set(i, r.err);
         self.tri[i] = tri as u32;
+    }
+
+    /// `triangle` of every lane from a mesh of at most eight triangles: the alias draw
+    /// (`AliasTable::sample`, the same operations) and the records' reads for all lanes at
+    /// once, each a `lookup8` of a register-held table; the vertex normals of a smooth mesh
+    /// lane by lane.
+    #[inline(always)]
+    fn small_mesh_triangles(&mut self, m: &SmallMesh, smooth: Option<&Mesh>, u: &[f32; LANES]) {
+        let (n, last) = (m.n as f32, (m.n - 1) as f32);
+        let (mut x, mut bin) = ([0.0; LANES], [0u32; LANES]);
+        for k in 0..LANES {
+            x[k] = u[k] * n;
+            // `bin_index(x, n)`: the clamp to n - 1, an integer, commutes with truncation.
+            bin[k] = x[k].max(0.0).min(last) as u32;
+        }
+        let (keep, alias) = (lookup8(&m.keep, &bin), lookup8(&m.alias, &bin));
+        let mut tri = [0u32; LANES];
+        for k in 0..LANES {
+            let frac = x[k] - bin[k] as f32;
+            tri[k] = if frac < keep[k] {
+                bin[k]
+            } else {
+                alias[k].to_bits()
+            };
+        }
+        let f = |j: usize| lookup8(&m.fields[j], &tri);
+        let v3 = |j: usize| V3x8 {
+            x: f(j),
+            y: f(j + 1),
+            z: f(j + 2),
+        };
+        self.v = [v3(0), v3(3), v3(6)];
+        (self.ng, self.err) = (v3(9), v3(12));
+        self.tri = tri;
+        if let Some(mesh) = smooth {
+            for i in 0..LANES {
+                if let Some(n) = mesh.vertex_normals(tri[i] as usize) {
+                    for (k, n) in n.into_iter().enumerate() {
+                        self.n[k].set(i, n);
+                    }
+                    self.has_normals[i] = true;
+                }
+            }
+        }
     }
 }
 
@@ -368,9 +414,15 @@ impl Direct<'_> {
             d.pmf = [pmf; LANES];
             match &light.kind {
                 LaneLightKind::Mesh {
+                    small: Some(small),
+                    smooth,
+                    ..
+                } => d.small_mesh_triangles(small, *smooth, u_tri),
+                LaneLightKind::Mesh {
                     triangles,
                     records,
                     smooth,
+                    ..
                 } => (0..LANES).for_each(|i| d.triangle(i, triangles, records, *smooth, u_tri[i])),
                 LaneLightKind::Sphere(sphere) => {
                     (spheres.sphere, spheres.any) = ([Some(**sphere); LANES], true)
@@ -392,6 +444,7 @@ impl Direct<'_> {
                     triangles,
                     records,
                     smooth,
+                    ..
                 } => d.triangle(i, triangles, records, *smooth, u_tri[i]),
                 LaneLightKind::Sphere(sphere) => {
                     (spheres.sphere[i], spheres.any) = (Some(**sphere), true);
@@ -588,5 +641,97 @@ pub(super) fn light_sample<const SPHERES: bool>(
     match ls {
         Some(ls) => (true, ls.wi, ls.pdf, ls.li, lsp),
         None => (false, Vec3::ZERO, 0.0, Rgb::ZERO, lsp),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+
+    /// A fan of `n` triangles of unequal areas (the second of zero area, which the alias
+    /// table must never draw), with vertex normals or without.
+    fn fan(n: usize, normals: bool) -> (Mesh, AliasTable, Vec<LightTriangle>) {
+        let mut positions = vec![Vec3::new(0.1, -0.2, 1.0)];
+        positions.extend((0..=n).map(|k| {
+            // Rim points 1 and 2 coincide: triangle 1 has no area.
+            let k = if k == 2 { 1 } else { k };
+            let a = k as f32 * 0.7;
+            let r = 1.0 + k as f32;
+            Vec3::new(r * a.cos(), r * a.sin(), 1.0 + 0.1 * k as f32)
+        }));
+        let indices: Vec<[u32; 3]> = (0..n as u32).map(|k| [0, k + 1, k + 2]).collect();
+        let vertex_normals = normals.then(|| {
+            (0..positions.len())
+                .map(|k| Vec3::new(0.1 * k as f32, -0.2, 1.0).normalize())
+                .collect()
+        });
+        let mesh = Mesh::new(positions, vertex_normals, indices);
+        let areas: Vec<f64> = (0..n)
+            .map(|t| {
+                let [a, b, c] = mesh.vertices(t);
+                0.5 * (b - a).cross(c - a).length() as f64
+            })
+            .collect();
+        let table = AliasTable::new(&areas).expect("a triangle of positive area");
+        let records = (0..n)
+            .map(|t| {
+                let (ng, err) = mesh.face(t);
+                LightTriangle {
+                    v: mesh.vertices(t),
+                    ng,
+                    err,
+                }
+            })
+            .collect();
+        (mesh, table, records)
+    }
+
+    fn bits(v: &V3x8) -> [[u32; LANES]; 3] {
+        v.axes().map(|a| a.map(f32::to_bits))
+    }
+
+    /// `small_mesh_triangles` draws, for every lane, bitwise what `triangle` draws with the
+    /// same number: meshes of 1 to 8 triangles, flat and smooth, random numbers and edges
+    /// (0, the largest below 1, the bin boundaries).
+    #[test]
+    fn small_mesh_draws_are_the_per_lane_draws() {
+        let below_one = f32::from_bits(1.0f32.to_bits() - 1);
+        let mut rng = Rng::new(3, 9);
+        for n in 1..=8 {
+            for normals in [false, true] {
+                let (mesh, table, records) = fan(n, normals);
+                let small = SmallMesh::new(&table, &records).expect("at most eight");
+                let smooth = normals.then_some(&mesh);
+                let edges: [f32; LANES] = std::array::from_fn(|k| match k {
+                    0 => 0.0,
+                    1 => below_one,
+                    _ => (k as f32 - 1.0) / n as f32,
+                });
+                let mut batches = vec![edges];
+                batches.extend((0..200).map(|_| std::array::from_fn(|_| rng.next_f32())));
+                for u in batches {
+                    let (mut a, mut b) = (LightDraws::default(), LightDraws::default());
+                    (0..LANES).for_each(|i| a.triangle(i, &table, &records, smooth, u[i]));
+                    b.small_mesh_triangles(&small, smooth, &u);
+                    assert_eq!(a.tri, b.tri, "n {n}, u {u:?}");
+                    assert!(a.tri.iter().all(|&t| t != 1), "the zero-area triangle");
+                    for k in 0..3 {
+                        assert_eq!(bits(&a.v[k]), bits(&b.v[k]));
+                        assert_eq!(bits(&a.n[k]), bits(&b.n[k]));
+                    }
+                    assert_eq!((bits(&a.ng), bits(&a.err)), (bits(&b.ng), bits(&b.err)));
+                    assert_eq!(a.has_normals, b.has_normals);
+                    assert_eq!(a.has_normals, [normals; LANES]);
+                }
+            }
+        }
+    }
+
+    /// Meshes of more than eight triangles keep the per-lane tables.
+    #[test]
+    fn larger_meshes_have_no_small_tables() {
+        let (_, table, records) = fan(9, false);
+        assert!(SmallMesh::new(&table, &records).is_none());
     }
 }

@@ -74,6 +74,12 @@ impl AliasTable {
         self.total
     }
 
+    /// Bin i: the probability of keeping it (against the fractional part of `u * len`) and
+    /// its alias.
+    pub fn bin(&self, i: usize) -> (f32, u32) {
+        self.bins[i]
+    }
+
     #[inline]
     pub fn pmf(&self, i: usize) -> f32 {
         self.pmf[i]
