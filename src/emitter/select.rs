@@ -59,6 +59,24 @@ impl EmitterSelector {
         (self.count == 1).then(|| self.pmf(0))
     }
 
+    /// Bin i of the choice as `sample` makes it: the probability of keeping the bin
+    /// (against the fractional part of `u * count`) and its alias. Uniform choice keeps
+    /// every bin.
+    pub fn bin(&self, i: usize) -> (f32, u32) {
+        match &self.table {
+            Some(t) => t.bin(i),
+            None => (f32::INFINITY, i as u32),
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
     #[inline]
     pub fn pmf(&self, i: usize) -> f32 {
         match &self.table {

@@ -52,12 +52,13 @@ struct Shading<'m> {
 
 impl<'a> Direct<'a> {
     pub fn new(scene: &'a Scene, strategy: Strategy) -> Self {
+        let selector = EmitterSelector::new(&scene.emitters, strategy.selection);
         Direct {
             scene,
             strategy,
-            selector: EmitterSelector::new(&scene.emitters, strategy.selection),
             has_delta_lights: scene.emitters.iter().any(|e| e.is_delta()),
-            lanes: lane_setup(scene, &strategy),
+            lanes: lane_setup(scene, &strategy, &selector),
+            selector,
         }
     }
 

@@ -6,7 +6,7 @@
 use super::Strategy;
 use crate::bsdf::fresnel::is_grey;
 use crate::bsdf::{BsdfKind, RoughConductor};
-use crate::emitter::{AreaLight, Emitter, LightSampling};
+use crate::emitter::{AreaLight, Emitter, EmitterSelector, LightSampling};
 use crate::geometry::{Mesh, ShapeKind, Sphere, NO_SKIP};
 use crate::sampling::microfacet::MicrofacetDistribution;
 use crate::sampling::AliasTable;
@@ -135,12 +135,73 @@ pub(super) struct LaneShape {
 pub(super) struct Lanes<'a> {
     pub(super) lights: Vec<LaneLight<'a>>,
     pub(super) shapes: Vec<LaneShape>,
+    /// The emitter choice in lane form, for two to eight emitters.
+    pub(super) small_lights: Option<Box<SmallLights>>,
+}
+
+/// Two to eight emitters (the Veach scene has five) as tables of eight entries, one per
+/// emitter, which `lookup8` reads for eight lanes at once: the emitter choice's bins and
+/// pmf, and what `light_draws` copies of the drawn light. A lane whose light is a mesh
+/// still draws its triangle alone. Drawn with a scalar choice and copy per lane, the Veach
+/// scene's lights took about two fifths of the lane kernel's time.
+pub(super) struct SmallLights {
+    pub(super) n: u32,
+    pub(super) keep: [f32; 8],
+    /// Each bin's alias, as f32 bits (the lookup moves bits).
+    pub(super) alias: [f32; 8],
+    pub(super) pmf: [f32; 8],
+    /// Each light's shape, as f32 bits.
+    pub(super) shape: [f32; 8],
+    pub(super) radiance: [[f32; 8]; 3],
+    pub(super) area: [f32; 8],
+    /// Each light's sphere, if it is one.
+    pub(super) sphere: [Option<Sphere>; 8],
+    /// The lights that are meshes, as a mask.
+    pub(super) meshes: u32,
+}
+
+impl SmallLights {
+    pub(super) fn new(lights: &[LaneLight], selector: &EmitterSelector) -> Option<Self> {
+        if !(2..=8).contains(&lights.len()) || selector.len() != lights.len() {
+            return None;
+        }
+        let mut t = SmallLights {
+            n: lights.len() as u32,
+            keep: [0.0; 8],
+            alias: [0.0; 8],
+            pmf: [0.0; 8],
+            shape: [0.0; 8],
+            radiance: [[0.0; 8]; 3],
+            area: [0.0; 8],
+            sphere: [None; 8],
+            meshes: 0,
+        };
+        for (e, light) in lights.iter().enumerate() {
+            let (keep, alias) = selector.bin(e);
+            (t.keep[e], t.alias[e]) = (keep, f32::from_bits(alias));
+            t.pmf[e] = selector.pmf(e);
+            (t.shape[e], t.area[e]) = (f32::from_bits(light.shape), light.area);
+            for (c, r) in light.radiance.to_array().into_iter().enumerate() {
+                t.radiance[c][e] = r;
+            }
+            match light.kind {
+                LaneLightKind::Sphere(s) => t.sphere[e] = Some(*s),
+                LaneLightKind::Mesh { .. } => t.meshes |= 1 << e,
+            }
+        }
+        Some(t)
+    }
 }
 
 /// The lanes' tables if the scene and strategy are the configuration the lanes cover;
 /// otherwise None and `Direct` shades every sample with `li`.
-pub(super) fn lane_setup<'a>(scene: &'a Scene, s: &Strategy) -> Option<Lanes<'a>> {
+pub(super) fn lane_setup<'a>(
+    scene: &'a Scene,
+    s: &Strategy,
+    selector: &EmitterSelector,
+) -> Option<Lanes<'a>> {
     let lights = lane_lights(scene, s)?;
+    let small_lights = SmallLights::new(&lights, selector).map(Box::new);
     let shapes = (0u32..)
         .zip(&scene.shapes)
         .map(|(shape, sh)| {
@@ -166,7 +227,11 @@ pub(super) fn lane_setup<'a>(scene: &'a Scene, s: &Strategy) -> Option<Lanes<'a>
             }
         })
         .collect();
-    Some(Lanes { lights, shapes })
+    Some(Lanes {
+        lights,
+        shapes,
+        small_lights,
+    })
 }
 
 /// The lane lights, one per emitter, if the scene and strategy are the configuration the
@@ -243,7 +308,12 @@ mod tests {
             // Point lights send a scene to the scalar path.
             desc.point_lights.clear();
             let scene = Scene::build(desc).unwrap();
-            let lanes = lane_setup(&scene, &mis()).expect("covered");
+            let lanes = lane_setup(
+                &scene,
+                &mis(),
+                &EmitterSelector::new(&scene.emitters, mis().selection),
+            )
+            .expect("covered");
             assert_eq!(lanes.shapes.len(), scene.shapes.len());
             let mut kinds = [0; 3];
             for (i, (row, shape)) in lanes.shapes.iter().zip(&scene.shapes).enumerate() {
@@ -305,7 +375,12 @@ mod tests {
     #[test]
     fn light_triangle_records_are_the_mesh_triangles() {
         let scene = Scene::build(load("cbox-meshlight/cbox-meshlight.xml")).unwrap();
-        let lanes = lane_setup(&scene, &mis()).expect("covered");
+        let lanes = lane_setup(
+            &scene,
+            &mis(),
+            &EmitterSelector::new(&scene.emitters, mis().selection),
+        )
+        .expect("covered");
         let mut checked = 0;
         for (light, e) in lanes.lights.iter().zip(&scene.emitters) {
             let LaneLightKind::Mesh {

@@ -20,7 +20,7 @@
 
 use super::direct::{heuristic, Direct};
 use super::lane_tables::{
-    LaneLight, LaneLightKind, LaneMaterial, LaneShape, LightTriangle, SmallMesh,
+    LaneLight, LaneLightKind, LaneMaterial, LaneShape, LightTriangle, SmallLights, SmallMesh,
 };
 use crate::bsdf::{BsdfSample, Diffuse};
 use crate::emitter::{area_pdf_along, sample_at, sphere_area_point};
@@ -154,29 +154,53 @@ impl LightDraws {
         self.tri[i] = tri as u32;
     }
 
+    /// `light_draws`'s emitter choice and copies for two to eight emitters, for all lanes at
+    /// once from register-held tables (`SmallLights`); lanes whose light is a mesh then draw
+    /// their triangles one by one.
+    #[inline(always)]
+    fn small_lights(
+        &mut self,
+        t: &SmallLights,
+        lights: &[LaneLight],
+        u_emitter: &[f32; LANES],
+        u_tri: &[f32; LANES],
+        spheres: &mut SphereDraws,
+    ) {
+        let e = alias_lanes(t.n, &t.keep, &t.alias, u_emitter);
+        self.pmf = lookup8(&t.pmf, &e);
+        self.shape = lookup8(&t.shape, &e).map(f32::to_bits);
+        self.radiance = V3x8 {
+            x: lookup8(&t.radiance[0], &e),
+            y: lookup8(&t.radiance[1], &e),
+            z: lookup8(&t.radiance[2], &e),
+        };
+        self.area = lookup8(&t.area, &e);
+        let mut meshes = 0;
+        for i in 0..LANES {
+            spheres.sphere[i] = t.sphere[e[i] as usize];
+            meshes |= (t.meshes >> e[i] & 1) << i;
+        }
+        spheres.any = meshes != (1 << LANES) - 1;
+        for i in bits(meshes) {
+            if let LaneLightKind::Mesh {
+                triangles,
+                records,
+                smooth,
+                ..
+            } = &lights[e[i] as usize].kind
+            {
+                self.triangle(i, triangles, records, *smooth, u_tri[i]);
+            }
+        }
+    }
+
     /// `triangle` of every lane from a mesh of at most eight triangles: the alias draw
     /// (`AliasTable::sample`, the same operations) and the records' reads for all lanes at
     /// once, each a `lookup8` of a register-held table; the vertex normals of a smooth mesh
     /// lane by lane.
     #[inline(always)]
     fn small_mesh_triangles(&mut self, m: &SmallMesh, smooth: Option<&Mesh>, u: &[f32; LANES]) {
-        let (n, last) = (m.n as f32, (m.n - 1) as f32);
-        let (mut x, mut bin) = ([0.0; LANES], [0u32; LANES]);
-        for k in 0..LANES {
-            x[k] = u[k] * n;
-            // `bin_index(x, n)`: the clamp to n - 1, an integer, commutes with truncation.
-            bin[k] = x[k].max(0.0).min(last) as u32;
-        }
-        let (keep, alias) = (lookup8(&m.keep, &bin), lookup8(&m.alias, &bin));
-        let mut tri = [0u32; LANES];
-        for k in 0..LANES {
-            let frac = x[k] - bin[k] as f32;
-            tri[k] = if frac < keep[k] {
-                bin[k]
-            } else {
-                alias[k].to_bits()
-            };
-        }
+        let tri = alias_lanes(m.n, &m.keep, &m.alias, u);
         let f = |j: usize| lookup8(&m.fields[j], &tri);
         let v3 = |j: usize| V3x8 {
             x: f(j),
@@ -197,6 +221,30 @@ impl LightDraws {
             }
         }
     }
+}
+
+/// `AliasTable::sample` of each lane's number, for a table of `n` (at most eight) bins held
+/// as `lookup8` tables of keep probabilities and aliases (as f32 bits): the same operations.
+#[inline(always)]
+fn alias_lanes(n: u32, keep: &[f32; 8], alias: &[f32; 8], u: &[f32; LANES]) -> [u32; LANES] {
+    let (nf, last) = (n as f32, (n - 1) as f32);
+    let (mut x, mut bin) = ([0.0; LANES], [0u32; LANES]);
+    for k in 0..LANES {
+        x[k] = u[k] * nf;
+        // `bin_index(x, n)`: the clamp to n - 1, an integer, commutes with truncation.
+        bin[k] = x[k].max(0.0).min(last) as u32;
+    }
+    let (keep, alias) = (lookup8(keep, &bin), lookup8(alias, &bin));
+    let mut out = [0u32; LANES];
+    for k in 0..LANES {
+        let frac = x[k] - bin[k] as f32;
+        out[k] = if frac < keep[k] {
+            bin[k]
+        } else {
+            alias[k].to_bits()
+        };
+    }
+    out
 }
 
 /// The lanes' rays and candidate contributions, before visibility. Every shading pass writes
@@ -255,7 +303,8 @@ impl Direct<'_> {
         let u: [[f32; LANES]; 7] = std::array::from_fn(|_| rng.next_f32());
         self.camera_hits(&lanes.shapes, rays, n, &at_hit, &mut out, hits);
         let mut spheres = SphereDraws::default();
-        self.light_draws(&lanes.lights, &u[0], &u[1], draws, &mut spheres);
+        let small = lanes.small_lights.as_deref();
+        self.light_draws(&lanes.lights, small, &u[0], &u[1], draws, &mut spheres);
         // Sphere lights take a branch per lane, which the mesh-only loop is spared.
         match (hits.rough, spheres.any) {
             (true, _) => self.shade_and_trace_rough(hits, draws, &spheres, &u, shaded, &mut out),
@@ -398,6 +447,7 @@ impl Direct<'_> {
     fn light_draws(
         &self,
         lights: &[LaneLight],
+        small: Option<&SmallLights>,
         u_emitter: &[f32; LANES],
         u_tri: &[f32; LANES],
         d: &mut LightDraws,
@@ -429,6 +479,9 @@ impl Direct<'_> {
                 }
             }
             return;
+        }
+        if let Some(t) = small {
+            return d.small_lights(t, lights, u_emitter, u_tri, spheres);
         }
         for i in 0..LANES {
             let Some((e, pmf)) = self.selector.sample(u_emitter[i]) else {
@@ -726,6 +779,88 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// `small_lights` draws, for every lane, bitwise what `light_draws`' per-lane loop draws
+    /// with the same numbers: sphere lights (the Veach scene), mesh lights (two quads), and
+    /// both in one scene, by uniform and by power choice; random numbers and the edges.
+    #[test]
+    fn small_lights_draws_are_the_per_lane_draws() {
+        use crate::emitter::EmitterSelection;
+        use crate::scene::bundled_tests::load;
+        let veach = load("veach-mis/veach-mis.xml");
+        let quads = load("cbox-twolights/cbox-twolights.xml");
+        let mut mixed = veach.clone();
+        mixed
+            .shapes
+            .extend(quads.shapes.iter().filter(|s| s.emitter.is_some()).cloned());
+        let below_one = f32::from_bits(1.0f32.to_bits() - 1);
+        let mut rng = Rng::new(4, 1);
+        let mut kinds = [0; 2];
+        for desc in [veach, quads, mixed] {
+            let scene = Scene::build(desc).unwrap();
+            for selection in [EmitterSelection::Uniform, EmitterSelection::Power] {
+                let strategy = crate::integrator::Strategy::combinations()
+                    .into_iter()
+                    .find(|s| {
+                        s.kind == crate::scene::desc::StrategyKind::Mis
+                            && s.emitter_samples == 1
+                            && s.selection == selection
+                            && s.light_sampling == crate::emitter::LightSampling::Area
+                    })
+                    .unwrap();
+                let direct = Direct::new(&scene, strategy);
+                let lanes = direct.lanes.as_ref().expect("covered");
+                let small = lanes.small_lights.as_deref().expect("two to eight lights");
+                let n = scene.emitters.len() as f32;
+                let edges: [f32; LANES] = std::array::from_fn(|k| match k {
+                    0 => 0.0,
+                    1 => below_one,
+                    _ => (k as f32 - 1.0) / n,
+                });
+                let mut batches = vec![(edges, edges)];
+                batches.extend((0..300).map(|_| {
+                    let mut u = || std::array::from_fn(|_| rng.next_f32());
+                    (u(), u())
+                }));
+                for (u_e, u_t) in batches {
+                    let (mut a, mut b) = (LightDraws::default(), LightDraws::default());
+                    let (mut sa, mut sb) = (SphereDraws::default(), SphereDraws::default());
+                    direct.light_draws(&lanes.lights, None, &u_e, &u_t, &mut a, &mut sa);
+                    direct.light_draws(&lanes.lights, Some(small), &u_e, &u_t, &mut b, &mut sb);
+                    assert_eq!(a.shape, b.shape, "u {u_e:?}");
+                    assert_eq!(a.pmf.map(f32::to_bits), b.pmf.map(f32::to_bits));
+                    assert_eq!(a.area.map(f32::to_bits), b.area.map(f32::to_bits));
+                    assert_eq!(bits(&a.radiance), bits(&b.radiance));
+                    assert_eq!(sa.any, sb.any);
+                    for i in 0..LANES {
+                        match (sa.sphere[i], sb.sphere[i]) {
+                            (Some(x), Some(y)) => {
+                                assert_eq!((x.center, x.radius), (y.center, y.radius));
+                                assert_eq!(x.flip_normals, y.flip_normals);
+                                kinds[0] += 1;
+                            }
+                            (None, None) => {
+                                assert_eq!(a.tri[i], b.tri[i]);
+                                for k in 0..3 {
+                                    assert_eq!(a.v[k].get(i), b.v[k].get(i));
+                                }
+                                assert_eq!(
+                                    (a.ng.get(i), a.err.get(i)),
+                                    (b.ng.get(i), b.err.get(i))
+                                );
+                                kinds[1] += 1;
+                            }
+                            _ => panic!("lane {i}: a sphere in one draw only"),
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            kinds.iter().all(|&k| k > 1000),
+            "sphere and mesh lanes {kinds:?}"
+        );
     }
 
     /// Meshes of more than eight triangles keep the per-lane tables.
