@@ -227,8 +227,9 @@ mod imp {
 pub use imp::{F8, M8};
 
 /// `table[idx[i]]` in each lane i, for indices below 8: a table of up to eight entries held
-/// in a register and read by one permute (AVX2), where a lookup per lane takes a load, and
-/// a gather costs dozens of cycles on this machine's CPUs. The bits move unchanged.
+/// in a register and read by one permute (AVX2), where a lookup per lane takes a load and a
+/// store, and AVX-512 gathers of the same entries measured slower than those (see README).
+/// The bits move unchanged.
 #[inline(always)]
 pub fn lookup8(table: &[f32; 8], idx: &[u32; 8]) -> [f32; 8] {
     debug_assert!(idx.iter().all(|&i| i < 8));
