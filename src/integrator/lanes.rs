@@ -143,12 +143,7 @@ impl LightDraws {
         for (k, v) in r.v.into_iter().enumerate() {
             self.v[k].set(i, v);
         }
-        if let Some(n) = smooth.and_then(|m| m.vertex_normals(tri)) {
-            for (k, n) in n.into_iter().enumerate() {
-                self.n[k].set(i, n);
-            }
-            self.has_normals[i] = true;
-        }
+        self.vertex_normals(i, smooth, tri);
         self.ng.set(i, r.ng);
         self.err.set(i, r.err);
         self.tri[i] = tri as u32;
@@ -210,15 +205,19 @@ impl LightDraws {
         self.v = [v3(0), v3(3), v3(6)];
         (self.ng, self.err) = (v3(9), v3(12));
         self.tri = tri;
-        if let Some(mesh) = smooth {
-            for i in 0..LANES {
-                if let Some(n) = mesh.vertex_normals(tri[i] as usize) {
-                    for (k, n) in n.into_iter().enumerate() {
-                        self.n[k].set(i, n);
-                    }
-                    self.has_normals[i] = true;
-                }
+        if smooth.is_some() {
+            (0..LANES).for_each(|i| self.vertex_normals(i, smooth, tri[i] as usize));
+        }
+    }
+
+    /// Lane i's vertex normals of triangle `tri`, where the mesh has them.
+    #[inline(always)]
+    fn vertex_normals(&mut self, i: usize, smooth: Option<&Mesh>, tri: usize) {
+        if let Some(n) = smooth.and_then(|m| m.vertex_normals(tri)) {
+            for (k, n) in n.into_iter().enumerate() {
+                self.n[k].set(i, n);
             }
+            self.has_normals[i] = true;
         }
     }
 }
