@@ -7,7 +7,8 @@ use super::Strategy;
 use crate::bsdf::fresnel::is_grey;
 use crate::bsdf::{BsdfKind, RoughConductor};
 use crate::emitter::{AreaLight, Emitter, EmitterSelector, LightSampling};
-use crate::geometry::{Mesh, ShapeKind, Sphere, NO_SKIP};
+use crate::geometry::{lookup8, Mesh, ShapeKind, Sphere, NO_SKIP};
+use crate::rng::LANES;
 use crate::sampling::microfacet::MicrofacetDistribution;
 use crate::sampling::AliasTable;
 use crate::scene::desc::StrategyKind;
@@ -69,15 +70,61 @@ impl LightTriangle {
     }
 }
 
+/// An alias table of at most eight bins (`AliasTable`, or the emitter choice) as tables of
+/// eight entries, which `lookup8` reads for eight lanes at once.
+pub(super) struct LaneAlias {
+    n: u32,
+    keep: [f32; 8],
+    /// Each bin's alias, as f32 bits (the lookup moves bits).
+    alias: [f32; 8],
+}
+
+impl LaneAlias {
+    /// The table of `n` (1 to 8) bins whose keep probability and alias `bin` gives.
+    fn new(n: usize, bin: impl Fn(usize) -> (f32, u32)) -> Self {
+        debug_assert!((1..=8).contains(&n));
+        let mut t = LaneAlias {
+            n: n as u32,
+            keep: [0.0; 8],
+            alias: [0.0; 8],
+        };
+        for i in 0..n {
+            let (keep, alias) = bin(i);
+            (t.keep[i], t.alias[i]) = (keep, f32::from_bits(alias));
+        }
+        t
+    }
+
+    /// `AliasTable::sample` of each lane's number, with the same operations.
+    #[inline(always)]
+    pub(super) fn draw(&self, u: &[f32; LANES]) -> [u32; LANES] {
+        let (nf, last) = (self.n as f32, (self.n - 1) as f32);
+        let (mut x, mut bin) = ([0.0; LANES], [0u32; LANES]);
+        for k in 0..LANES {
+            x[k] = u[k] * nf;
+            // `bin_index(x, n)`: the clamp to n - 1, an integer, commutes with truncation.
+            bin[k] = x[k].max(0.0).min(last) as u32;
+        }
+        let (keep, alias) = (lookup8(&self.keep, &bin), lookup8(&self.alias, &bin));
+        let mut out = [0u32; LANES];
+        for k in 0..LANES {
+            let frac = x[k] - bin[k] as f32;
+            out[k] = if frac < keep[k] {
+                bin[k]
+            } else {
+                alias[k].to_bits()
+            };
+        }
+        out
+    }
+}
+
 /// A light mesh of at most eight triangles (a quad light has two) as tables of eight
 /// entries, one per triangle: its alias table's bins and its records' fields, which
 /// `lookup8` reads for eight lanes at once. Drawn with a scalar lookup per lane, the Cornell
 /// box light's triangles took about a fifth of the lane kernel's time.
 pub(super) struct SmallMesh {
-    pub(super) n: u32,
-    pub(super) keep: [f32; 8],
-    /// Each bin's alias, as f32 bits (the lookup moves bits).
-    pub(super) alias: [f32; 8],
+    pub(super) triangles: LaneAlias,
     /// The records' fields, field-major: `v[0].x, v[0].y, v[0].z, v[1].x, ..., ng.x, ...,
     /// err.z`.
     pub(super) fields: [[f32; 8]; 15],
@@ -89,14 +136,10 @@ impl SmallMesh {
             return None;
         }
         let mut m = SmallMesh {
-            n: records.len() as u32,
-            keep: [0.0; 8],
-            alias: [0.0; 8],
+            triangles: LaneAlias::new(records.len(), |t| triangles.bin(t)),
             fields: [[0.0; 8]; 15],
         };
         for (t, r) in records.iter().enumerate() {
-            let (keep, alias) = triangles.bin(t);
-            (m.keep[t], m.alias[t]) = (keep, f32::from_bits(alias));
             let vectors = [r.v[0], r.v[1], r.v[2], r.ng, r.err];
             for (j, x) in vectors.iter().flat_map(|v| v.to_array()).enumerate() {
                 m.fields[j][t] = x;
@@ -145,10 +188,7 @@ pub(super) struct Lanes<'a> {
 /// still draws its triangle alone. Drawn with a scalar choice and copy per lane, the Veach
 /// scene's lights took about two fifths of the lane kernel's time.
 pub(super) struct SmallLights {
-    pub(super) n: u32,
-    pub(super) keep: [f32; 8],
-    /// Each bin's alias, as f32 bits (the lookup moves bits).
-    pub(super) alias: [f32; 8],
+    pub(super) choice: LaneAlias,
     pub(super) pmf: [f32; 8],
     /// Each light's shape, as f32 bits.
     pub(super) shape: [f32; 8],
@@ -166,9 +206,7 @@ impl SmallLights {
             return None;
         }
         let mut t = SmallLights {
-            n: lights.len() as u32,
-            keep: [0.0; 8],
-            alias: [0.0; 8],
+            choice: LaneAlias::new(lights.len(), |e| selector.bin(e)),
             pmf: [0.0; 8],
             shape: [0.0; 8],
             radiance: [[0.0; 8]; 3],
@@ -177,8 +215,6 @@ impl SmallLights {
             meshes: 0,
         };
         for (e, light) in lights.iter().enumerate() {
-            let (keep, alias) = selector.bin(e);
-            (t.keep[e], t.alias[e]) = (keep, f32::from_bits(alias));
             t.pmf[e] = selector.pmf(e);
             (t.shape[e], t.area[e]) = (f32::from_bits(light.shape), light.area);
             for (c, r) in light.radiance.to_array().into_iter().enumerate() {

@@ -161,7 +161,7 @@ impl LightDraws {
         u_tri: &[f32; LANES],
         spheres: &mut SphereDraws,
     ) {
-        let e = alias_lanes(t.n, &t.keep, &t.alias, u_emitter);
+        let e = t.choice.draw(u_emitter);
         self.pmf = lookup8(&t.pmf, &e);
         self.shape = lookup8(&t.shape, &e).map(f32::to_bits);
         self.radiance = V3x8 {
@@ -195,7 +195,7 @@ impl LightDraws {
     /// lane by lane.
     #[inline(always)]
     fn small_mesh_triangles(&mut self, m: &SmallMesh, smooth: Option<&Mesh>, u: &[f32; LANES]) {
-        let tri = alias_lanes(m.n, &m.keep, &m.alias, u);
+        let tri = m.triangles.draw(u);
         let f = |j: usize| lookup8(&m.fields[j], &tri);
         let v3 = |j: usize| V3x8 {
             x: f(j),
@@ -220,30 +220,6 @@ impl LightDraws {
             self.has_normals[i] = true;
         }
     }
-}
-
-/// `AliasTable::sample` of each lane's number, for a table of `n` (at most eight) bins held
-/// as `lookup8` tables of keep probabilities and aliases (as f32 bits): the same operations.
-#[inline(always)]
-fn alias_lanes(n: u32, keep: &[f32; 8], alias: &[f32; 8], u: &[f32; LANES]) -> [u32; LANES] {
-    let (nf, last) = (n as f32, (n - 1) as f32);
-    let (mut x, mut bin) = ([0.0; LANES], [0u32; LANES]);
-    for k in 0..LANES {
-        x[k] = u[k] * nf;
-        // `bin_index(x, n)`: the clamp to n - 1, an integer, commutes with truncation.
-        bin[k] = x[k].max(0.0).min(last) as u32;
-    }
-    let (keep, alias) = (lookup8(keep, &bin), lookup8(alias, &bin));
-    let mut out = [0u32; LANES];
-    for k in 0..LANES {
-        let frac = x[k] - bin[k] as f32;
-        out[k] = if frac < keep[k] {
-            bin[k]
-        } else {
-            alias[k].to_bits()
-        };
-    }
-    out
 }
 
 /// The lanes' rays and candidate contributions, before visibility. Every shading pass writes
