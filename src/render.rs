@@ -397,8 +397,18 @@ mod tests {
                 }
             }
         };
+        // Plates of a grey index other than the scene's eta 0, k 1, whose conductor term is
+        // exactly 1 at every angle: the lanes' Fresnel with a value to get wrong.
+        let grey_plates = |d: &mut SceneDesc| {
+            use crate::scene::desc::BsdfDesc;
+            for shape in &mut d.shapes {
+                if let BsdfDesc::RoughConductor { eta, k, .. } = &mut shape.bsdf {
+                    (*eta, *k) = (Vec3::splat(0.2), Vec3::splat(3.0));
+                }
+            }
+        };
         type Edit = dyn Fn(&mut SceneDesc);
-        let cases: [(&str, &Edit, crate::integrator::Strategy, bool); 9] = [
+        let cases: [(&str, &Edit, crate::integrator::Strategy, bool); 10] = [
             ("cbox/cbox.xml", &keep, mis, true),
             // A light mesh of many triangles: the lanes' per-triangle records.
             ("cbox-meshlight/cbox-meshlight.xml", &keep, power, true),
@@ -429,6 +439,7 @@ mod tests {
             ("cbox-materials/cbox-materials.xml", &keep, power, false),
             ("veach-mis/veach-mis.xml", &tent, mis, true),
             ("veach-mis/veach-mis.xml", &rough_plates, power, true),
+            ("veach-mis/veach-mis.xml", &grey_plates, power, true),
         ];
         for (rel, edit, strategy, lanes) in cases {
             let mut desc = crate::scene::bundled_tests::load(rel);
