@@ -176,6 +176,22 @@ fn render_pixel(
     }
 }
 
+/// The pixels of image rows `rows`, rendered on this thread as a render's worker renders a
+/// tile: the bench times renders band by band against the traversal of the same rays
+/// (`bench::raylimit::measure_interleaved`). Returns the sum of their red means, so that no
+/// pixel's work can be dropped.
+pub fn render_rows(
+    direct: &Direct,
+    rows: std::ops::Range<u32>,
+    settings: &RenderSettings,
+    scratch: &mut LaneScratch,
+) -> f64 {
+    let w = direct.scene.camera.width;
+    rows.flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| render_pixel(direct, x, y, settings, scratch).mean[0])
+        .sum()
+}
+
 pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> RenderOutput {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let direct = Direct::new(scene, strategy);
@@ -338,6 +354,33 @@ mod tests {
             assert_eq!(PixelStats::default().push_batch(&v, LANES), 1);
         }
         assert_eq!(PixelStats::default().finish(), ([0.0; 3], [0.0; 3]));
+    }
+
+    /// `render_rows` is the render's work: over all bands of rows, the same pixel means.
+    #[test]
+    fn rendered_rows_are_the_render() {
+        let mut desc = crate::scene::bundled_tests::load("veach-mis/veach-mis.xml");
+        (desc.film.width, desc.film.height) = (10, 7);
+        let scene = Scene::build(desc).unwrap();
+        let strategy = crate::integrator::Strategy::combinations()[0];
+        let settings = RenderSettings {
+            spp: 8,
+            seed: 3,
+            threads: Some(2),
+            progress: false,
+        };
+        let out = render(&scene, strategy, &settings);
+        let direct = Direct::new(&scene, strategy);
+        let mut scratch = LaneScratch::default();
+        for rows in [0..3, 3..4, 4..7] {
+            let band = render_rows(&direct, rows.clone(), &settings, &mut scratch);
+            let want: f64 = rows
+                .flat_map(|y| (0..10).map(move |x| (x, y)))
+                .map(|(x, y)| out.mean.get(x, y)[0])
+                .sum();
+            assert!(want > 0.0, "a lit band");
+            assert_eq!(band.to_bits(), want.to_bits());
+        }
     }
 
     /// The render loop starts samples eight at a time and, where `Direct::li_lanes` covers

@@ -458,6 +458,21 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             limit.share_outside_by_type * 100.0,
             limit.outside_seconds_per_sample * 1e9,
         );
+        // The same with tracing and rendering paired band by band.
+        let direct = crate::integrator::Direct::new(&scene, mis);
+        let banded = |threads| {
+            let spps = (mix_spp, a.spp);
+            let (share, outside) =
+                raylimit::measure_interleaved(&direct, &mix, spps, threads, a.repeat);
+            println!(
+                "  traced and rendered band by band ({} rows each) on {threads} thread(s): {:.0}% of render time outside traversal, {:.1} ns of thread time per sample",
+                raylimit::BAND_ROWS,
+                share * 100.0,
+                outside * 1e9,
+            );
+            (share, outside)
+        };
+        let (share_banded, outside_banded) = banded(1);
         // The same on the most threads, as Mitsuba's script measures Mitsuba (no fewer
         // than two threads), in thread time per sample.
         let parallel = (max_threads > 1).then(|| {
@@ -469,7 +484,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                 share * 100.0,
                 outside * 1e9,
             );
-            (share, outside)
+            (share, outside, banded(t))
         });
         let raw = raylimit::measure_obvhs(&scene, &mix, a.repeat);
         println!(
@@ -503,16 +518,28 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                 limit.outside_seconds_per_sample * 1e9,
                 "ns",
             ),
+            ("share_outside_traversal_banded", share_banded, "fraction"),
+            (
+                "outside_traversal_per_sample_banded",
+                outside_banded * 1e9,
+                "ns",
+            ),
             ("obvhs_closest_hit_rays", raw.closest_per_s, "rays/s"),
             ("obvhs_occlusion_rays", raw.occlusion_per_s, "rays/s"),
         ]
         .map(|row| (1, row));
-        let most_threads = parallel.into_iter().flat_map(|(share, outside)| {
+        let most_threads = parallel.into_iter().flat_map(|(share, outside, banded)| {
             [
                 ("share_outside_traversal", share, "fraction"),
                 (
                     "outside_traversal_per_sample",
                     outside * 1e9,
+                    "ns thread time",
+                ),
+                ("share_outside_traversal_banded", banded.0, "fraction"),
+                (
+                    "outside_traversal_per_sample_banded",
+                    banded.1 * 1e9,
                     "ns thread time",
                 ),
             ]

@@ -24,6 +24,9 @@ use crate::rng::{Rng, LANES};
 use crate::scene::Scene;
 use std::time::Instant;
 
+/// The seed whose samples the mix holds: a render with it traces the same rays.
+pub const MIX_SEED: u64 = 7;
+
 /// The mix, each ray stored once, in the renderer's packets.
 pub struct RayMix {
     /// Per group of up to `LANES` consecutive samples of a pixel: its camera and shadow rays
@@ -88,7 +91,7 @@ pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
                     });
                 }
                 let p = mix.packets.last_mut().expect("pushed above");
-                let mut rng = Rng::for_sample(7, (y * cam.width + x) as u64, s as u64);
+                let mut rng = Rng::for_sample(MIX_SEED, (y * cam.width + x) as u64, s as u64);
                 let ray = cam.generate_ray(x, y, &mut rng);
                 p.camera.0.set(lane, &ray);
                 p.camera.1 |= 1 << lane;
@@ -380,6 +383,89 @@ pub fn measure_threads(
     (median(shares), median(outside))
 }
 
+/// Image rows per band of `measure_interleaved`.
+pub const BAND_ROWS: u32 = 8;
+
+/// The share outside traversal with the mix's tracing and the render paired band by band
+/// (`BAND_ROWS` image rows, 10-80 ms each at the bench's 64 spp): each band's rays traced in the renderer's order,
+/// then the same band rendered at `spp` samples per pixel and the mix's seed (so that its
+/// first `mix_spp` samples are the rays traced), the order swapped every other band. On
+/// `threads` threads, each takes every `threads`-th band, and both sides count thread time.
+/// `measure` and `measure_threads` alternate a whole render and a whole replay, seconds
+/// apart, and a slow spell of this VM that hits one of them moved their share by ten points
+/// or more between runs; here both sides of each band see the same spell. Returns the median
+/// over `repeat` passes of (share, seconds of thread time per sample outside traversal).
+/// `mix_spp` must be the mix's.
+pub fn measure_interleaved(
+    direct: &crate::integrator::Direct,
+    mix: &RayMix,
+    (mix_spp, spp): (u32, u32),
+    threads: usize,
+    repeat: u32,
+) -> (f64, f64) {
+    use crate::render::{render_rows, RenderSettings};
+    let scene = direct.scene;
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let per_row = w as usize * (mix_spp as usize).div_ceil(LANES);
+    assert_eq!(
+        mix.packets.len(),
+        per_row * h as usize,
+        "a mix of {mix_spp} spp"
+    );
+    let settings = RenderSettings {
+        spp,
+        seed: MIX_SEED,
+        threads: Some(1),
+        progress: false,
+    };
+    let bands: Vec<_> = (0..h)
+        .step_by(BAND_ROWS as usize)
+        .map(|y0| y0..(y0 + BAND_ROWS).min(h))
+        .collect();
+    // One thread's bands: (sink, seconds tracing, seconds rendering).
+    let run = |mine: &mut dyn Iterator<Item = &std::ops::Range<u32>>| {
+        let mut scratch = crate::integrator::LaneScratch::default();
+        let (mut sink, mut traced, mut rendered) = (0.0, 0.0, 0.0);
+        for (k, rows) in mine.enumerate() {
+            let band = &mix.packets[rows.start as usize * per_row..rows.end as usize * per_row];
+            // Trace then render on even bands, render then trace on odd ones.
+            for trace in [k % 2 == 0, k % 2 == 1] {
+                if trace {
+                    let (s, seconds) = trace_in_order(scene, mix, band.chunks(CHUNK));
+                    (sink, traced) = (sink + s as f64, traced + seconds);
+                } else {
+                    let t = Instant::now();
+                    sink += render_rows(direct, rows.clone(), &settings, &mut scratch);
+                    rendered += t.elapsed().as_secs_f64();
+                }
+            }
+        }
+        (sink, traced, rendered)
+    };
+    let (mut shares, mut outside) = (Vec::new(), Vec::new());
+    let mut sink = 0.0;
+    for _ in 0..repeat.max(1) {
+        let (s, traced, rendered) = std::thread::scope(|sc| {
+            let runs: Vec<_> = (0..threads.max(1))
+                .map(|t| {
+                    let (run, bands) = (&run, &bands);
+                    sc.spawn(move || run(&mut bands.iter().skip(t).step_by(threads.max(1))))
+                })
+                .collect();
+            runs.into_iter()
+                .map(|r| r.join().expect("band thread"))
+                .fold((0.0, 0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2))
+        });
+        sink += s;
+        let traced = traced / mix.n_camera as f64;
+        let rendered = rendered / (w as f64 * h as f64 * spp as f64);
+        shares.push(1.0 - traced / rendered);
+        outside.push(rendered - traced);
+    }
+    std::hint::black_box(sink);
+    (median(shares), median(outside))
+}
+
 /// The same mix through obvhs's own CwBvh traversal and triangle test (spheres use
 /// directlab's sphere test): what the library gives without directlab's traversal. Not a
 /// renderer: its triangle test is not watertight and it culls hits closer than t = 1e-4.
@@ -498,6 +584,41 @@ mod tests {
                 "a diffuse floor draws a BSDF ray per hit"
             );
         }
+    }
+
+    /// The band-by-band pairing runs over an image whose height is not a multiple of the
+    /// band (its last band is short), on one thread and two, and gives a share below 1
+    /// (some traversal timed) and finite (some render timed); a mix of other samples per
+    /// pixel is refused.
+    #[test]
+    fn banded_share_over_a_short_last_band() {
+        let mut d = fixtures::triangle_over_floor(
+            [
+                Vec3::new(-1.0, -1.0, 2.0),
+                Vec3::new(0.0, 1.0, 2.0),
+                Vec3::new(1.0, -1.0, 2.0),
+            ],
+            1.0,
+            0.5,
+            Vec3::ZERO,
+            1.0,
+        );
+        (d.film.width, d.film.height) = (6, BAND_ROWS + 3);
+        let scene = Scene::build(d).expect("fixture scene");
+        let mis = crate::bench::bench_strategies()[0];
+        let direct = crate::integrator::Direct::new(&scene, mis);
+        let mix = ray_mix(&scene, 8, mis.selection);
+        for threads in [1, 2] {
+            let (share, outside) = measure_interleaved(&direct, &mix, (8, 24), threads, 1);
+            assert!(
+                share < 1.0 && share.is_finite() && outside.is_finite(),
+                "{threads} threads: {share}"
+            );
+        }
+        let refused =
+            std::panic::AssertUnwindSafe(|| measure_interleaved(&direct, &mix, (16, 24), 1, 1));
+        let other = std::panic::catch_unwind(refused);
+        assert!(other.is_err(), "a 16-spp pairing of an 8-spp mix");
     }
 
     /// The packets are the renderer's: up to `LANES` consecutive samples of one pixel (the
