@@ -404,7 +404,7 @@ pub fn measure_interleaved(
     repeat: u32,
 ) -> (f64, f64) {
     use crate::render::{render_rows, RenderSettings};
-    let scene = direct.scene;
+    let (scene, threads) = (direct.scene, threads.max(1));
     let (w, h) = (scene.camera.width, scene.camera.height);
     let per_row = w as usize * (mix_spp as usize).div_ceil(LANES);
     assert_eq!(
@@ -446,10 +446,10 @@ pub fn measure_interleaved(
     let mut sink = 0.0;
     for _ in 0..repeat.max(1) {
         let (s, traced, rendered) = std::thread::scope(|sc| {
-            let runs: Vec<_> = (0..threads.max(1))
+            let runs: Vec<_> = (0..threads)
                 .map(|t| {
                     let (run, bands) = (&run, &bands);
-                    sc.spawn(move || run(&mut bands.iter().skip(t).step_by(threads.max(1))))
+                    sc.spawn(move || run(&mut bands.iter().skip(t).step_by(threads)))
                 })
                 .collect();
             runs.into_iter()
