@@ -5,7 +5,7 @@
 
 #[cfg(test)]
 use super::elementary::exp;
-use super::elementary::ln;
+use super::elementary::{horner, ln};
 
 /// Complementary error function, relative error below 2.5e-7 for |x| <= 9 (0 beyond ~9.3,
 /// where exp(-x^2) leaves f32's normal range). The renderer calls `erfc_from_exp`; this and
@@ -23,32 +23,35 @@ pub fn erfc(x: f32) -> f32 {
 /// (erfcx(z) = exp(z^2) erfc(z), from mpmath at 40 digits) constrained to be exact at z = 0,
 /// so that erf is continuous and odd through 0. Fitted for f64 (1.41e-9), it is below f32's
 /// rounding here; a degree-10 fit would do as well in f32. The relative bound matters:
-/// Beckmann tails live in erfc's tail. Evaluated by Estrin's scheme, a shorter dependency
-/// chain than Horner's on the Halley steps' critical path.
+/// Beckmann tails live in erfc's tail. Evaluated by Estrin's scheme in fused multiply-adds,
+/// a shorter dependency chain than Horner's on the Halley steps' critical path.
 #[inline(always)]
 pub fn erfc_from_exp(x: f32, e: f32) -> f32 {
-    const C: [f32; 13] = [
-        0.510_791_36,
-        0.343_580_34,
-        0.139_736_06,
-        0.018_221_367,
-        -0.010_755_407,
-        -0.003_241_774_2,
-        0.001_545_272_2,
-        0.000_426_861_86,
-        -0.000_330_425_94,
-        -3.281_964_7e-5,
-        6.971_882e-5,
-        -1.365_704_7e-6,
+    // Q's coefficients, highest power first.
+    const Q: [f32; 13] = [
         -9.172_661e-6,
+        -1.365_704_7e-6,
+        6.971_882e-5,
+        -3.281_964_7e-5,
+        -0.000_330_425_94,
+        0.000_426_861_86,
+        0.001_545_272_2,
+        -0.003_241_774_2,
+        -0.010_755_407,
+        0.018_221_367,
+        0.139_736_06,
+        0.343_580_34,
+        0.510_791_36,
     ];
     let t = 1.0 / (1.0 + 0.5 * x.abs());
     let s = 2.0 * t - 1.0;
-    let (s2, s4) = (s * s, s * s * s * s);
-    let lo = (C[0] + C[1] * s + (C[2] + C[3] * s) * s2)
-        + (C[4] + C[5] * s + (C[6] + C[7] * s) * s2) * s4;
-    let hi = (C[8] + C[9] * s + (C[10] + C[11] * s) * s2) + C[12] * s4;
-    let r = e * t * (lo + hi * (s4 * s4));
+    // Estrin's scheme: pairs, then quads, then the two halves.
+    let (s2, s4) = (s * s, (s * s) * (s * s));
+    let pair = |i: usize| Q[i].mul_add(s, Q[i + 1]);
+    let quad = |i: usize| pair(i).mul_add(s2, pair(i + 2));
+    let low = quad(5).mul_add(s4, quad(9));
+    let high = Q[0].mul_add(s4, quad(1));
+    let r = e * t * high.mul_add(s4 * s4, low);
     if x >= 0.0 {
         r
     } else {
@@ -70,6 +73,7 @@ pub fn erfinv(y: f32) -> f32 {
     let y = y.clamp(-0.999_999_94, 0.999_999_94);
     let w = -ln((1.0 - y) * (1.0 + y));
     let centre = [
+        2.810_226_4e-8,
         3.432_739_4e-7,
         -3.523_387_7e-6,
         -4.391_506_5e-6,
@@ -80,6 +84,7 @@ pub fn erfinv(y: f32) -> f32 {
         1.501_409_4,
     ];
     let tail = [
+        -0.000_200_214_26,
         0.000_100_950_56,
         0.001_349_343_2,
         -0.003_673_428_4,
@@ -89,9 +94,8 @@ pub fn erfinv(y: f32) -> f32 {
         1.001_674,
         2.832_976_8,
     ];
-    let horner = |p0: f32, c: [f32; 8], w: f32| c.into_iter().fold(p0, |p, c| c + p * w);
-    let p_centre = horner(2.810_226_4e-8, centre, w - 2.5);
-    let p_tail = horner(-0.000_200_214_26, tail, w.sqrt() - 3.0);
+    let p_centre = horner(w - 2.5, &centre);
+    let p_tail = horner(w.sqrt() - 3.0, &tail);
     let p = if w < 5.0 { p_centre } else { p_tail };
     p * y
 }
