@@ -27,31 +27,30 @@ pub fn erfc(x: f32) -> f32 {
 /// a shorter dependency chain than Horner's on the Halley steps' critical path.
 #[inline(always)]
 pub fn erfc_from_exp(x: f32, e: f32) -> f32 {
-    // Q's coefficients, highest power first.
-    const Q: [f32; 13] = [
-        -9.172_661e-6,
-        -1.365_704_7e-6,
-        6.971_882e-5,
-        -3.281_964_7e-5,
-        -0.000_330_425_94,
-        0.000_426_861_86,
-        0.001_545_272_2,
-        -0.003_241_774_2,
-        -0.010_755_407,
-        0.018_221_367,
-        0.139_736_06,
-        0.343_580_34,
+    const C: [f32; 13] = [
         0.510_791_36,
+        0.343_580_34,
+        0.139_736_06,
+        0.018_221_367,
+        -0.010_755_407,
+        -0.003_241_774_2,
+        0.001_545_272_2,
+        0.000_426_861_86,
+        -0.000_330_425_94,
+        -3.281_964_7e-5,
+        6.971_882e-5,
+        -1.365_704_7e-6,
+        -9.172_661e-6,
     ];
     let t = 1.0 / (1.0 + 0.5 * x.abs());
     let s = 2.0 * t - 1.0;
-    // Estrin's scheme: pairs, then quads, then the two halves.
+    // Pairs of terms, then pairs of pairs, then the two halves.
     let (s2, s4) = (s * s, (s * s) * (s * s));
-    let pair = |i: usize| Q[i].mul_add(s, Q[i + 1]);
-    let quad = |i: usize| pair(i).mul_add(s2, pair(i + 2));
-    let low = quad(5).mul_add(s4, quad(9));
-    let high = Q[0].mul_add(s4, quad(1));
-    let r = e * t * high.mul_add(s4 * s4, low);
+    let pair = |i: usize| C[i + 1].mul_add(s, C[i]);
+    let quad = |i: usize| pair(i + 2).mul_add(s2, pair(i));
+    let lo = quad(4).mul_add(s4, quad(0));
+    let hi = C[12].mul_add(s4, quad(8));
+    let r = e * t * hi.mul_add(s4 * s4, lo);
     if x >= 0.0 {
         r
     } else {
