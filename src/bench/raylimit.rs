@@ -9,7 +9,7 @@
 //! surface's horizon, outside a narrow lobe) and no BSDF ray where the material draws none:
 //! rays the renderer never traces would count as traversal it does not do. The camera rays
 //! and the shadow rays of each pixel's groups of `LANES` samples are traced as packets, as
-//! the renderer traces them (`Scene::intersect8`, `Accel::occluded8`); BSDF rays one by one
+//! the renderer traces them (`Scene::intersect8_into`, `Accel::occluded8`); BSDF rays one by one
 //! past a box reject of the group's rays in lanes (`bsdf_queries`).
 //! Every timing traces the mix a chunk of 64 groups at a time, each chunk copied into cache
 //! first and untimed (`Warm`): the renderer makes its rays in registers, not in a stream of
@@ -194,7 +194,7 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
             let w = warm.load(mix, chunk);
             let t = Instant::now();
             for p in &w.packets {
-                sink += packet_prims(scene.intersect8(&p.camera.0, p.camera.1));
+                sink += packet_prims(scene, &p.camera);
             }
             let t1 = Instant::now();
             for (r, _) in &w.bsdf {
@@ -253,7 +253,10 @@ fn prim(h: Option<Hit>) -> usize {
     h.map_or(0, |h| h.sp.prim as usize & 1)
 }
 
-fn packet_prims(h: PacketHits) -> usize {
+/// The camera packet's hits as the renderer traces them (`camera_hits`: filled in place).
+fn packet_prims(scene: &Scene, (rays, active): &(RayPacket, u32)) -> usize {
+    let mut h = PacketHits::default();
+    scene.intersect8_into(rays, *active, &mut h);
     (0..LANES).map(|i| prim(h.get(i))).sum()
 }
 
@@ -334,7 +337,7 @@ fn trace_in_order<'a>(
         let w = warm.load(mix, chunk);
         let t = Instant::now();
         for (p, b) in w.packets.iter().zip(&w.bsdf_packets) {
-            sink += packet_prims(scene.intersect8(&p.camera.0, p.camera.1));
+            sink += packet_prims(scene, &p.camera);
             sink += scene.accel.occluded8(&p.shadow.0, p.shadow.1) as usize;
             sink += bsdf_queries(scene, b);
         }

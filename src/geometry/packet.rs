@@ -262,16 +262,32 @@ impl<'a> Rays<'a> {
 }
 
 impl Accel {
-    /// `intersect` for each ray set in `active`, traced as one packet.
+    /// `intersect8_into` a fresh `PacketHits`, for tests.
+    #[cfg(test)]
     pub fn intersect8(&self, rays: &RayPacket, active: u32, shapes: &[Shape]) -> PacketHits {
         let mut out = PacketHits::default();
+        self.intersect8_into(rays, active, shapes, &mut out);
+        out
+    }
+
+    /// `intersect` for each ray set in `active`, traced as one packet, into `out`, which
+    /// must hold `PacketHits::default()`. Returned by value, the 484-byte hits were copied
+    /// out by a `memcpy` call on every packet (LLVM did not build them in place, even
+    /// inlined): 0.8-1.1 % of a Veach render's time (perf).
+    pub fn intersect8_into(
+        &self,
+        rays: &RayPacket,
+        active: u32,
+        shapes: &[Shape],
+        out: &mut PacketHits,
+    ) {
         if active.count_ones() <= 1 {
             for i in bits(active) {
                 if let Some(hit) = self.intersect(&rays.ray(i), shapes) {
                     out.set(i, &hit);
                 }
             }
-            return out;
+            return;
         }
         let r = Rays::new(rays, active);
         let tmin8 = r.tmin8();
@@ -380,7 +396,6 @@ impl Accel {
                 F8::select(m, p, F8::load(out_p)).store(out_p);
             }
         }
-        out
     }
 
     /// `occluded` for each ray set in `active`, traced as one packet: the mask of those blocked.

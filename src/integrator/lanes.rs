@@ -310,7 +310,9 @@ impl Direct<'_> {
         h: &mut CameraHits,
     ) {
         let scene = self.scene;
-        let camera = scene.intersect8(rays, (1 << n) - 1);
+        // Filled in place: a returned `PacketHits` was copied by a `memcpy` call.
+        let mut camera = PacketHits::default();
+        scene.intersect8_into(rays, (1 << n) - 1, &mut camera);
         // What the paths below write for some lanes only, or not at all.
         (h.le, h.covered) = (V3x8::default(), 0);
         // Taken whole; lanes the loop below does not cover are dropped later.

@@ -313,10 +313,11 @@ impl Scene {
         self.accel.intersect(ray, &self.shapes)
     }
 
-    /// `intersect` of each ray set in `active`, traced as one packet.
+    /// `intersect` of each ray set in `active`, traced as one packet, into `out` (see
+    /// `Accel::intersect8_into`).
     #[inline]
-    pub fn intersect8(&self, rays: &RayPacket, active: u32) -> PacketHits {
-        self.accel.intersect8(rays, active, &self.shapes)
+    pub fn intersect8_into(&self, rays: &RayPacket, active: u32, out: &mut PacketHits) {
+        self.accel.intersect8_into(rays, active, &self.shapes, out)
     }
 
     /// The closest hit if it lies on an emitter.
