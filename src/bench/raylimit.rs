@@ -186,7 +186,7 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
     let (mut shares, mut shares_by_type, mut outside) = (Vec::new(), Vec::new(), Vec::new());
     let mut sink = 0usize;
     let n = mix.n_camera as f64;
-    let mut warm = Warm::default();
+    let (mut warm, mut hits) = (Warm::default(), PacketHits::default());
     for _ in 0..repeat.max(1) {
         // Each ray type back to back, within each warm chunk.
         let mut by_type = [0.0; 4];
@@ -194,7 +194,7 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
             let w = warm.load(mix, chunk);
             let t = Instant::now();
             for p in &w.packets {
-                sink += packet_prims(scene, &p.camera);
+                sink += packet_prims(scene, &p.camera, &mut hits);
             }
             let t1 = Instant::now();
             for (r, _) in &w.bsdf {
@@ -253,10 +253,10 @@ fn prim(h: Option<Hit>) -> usize {
     h.map_or(0, |h| h.sp.prim as usize & 1)
 }
 
-/// The camera packet's hits as the renderer traces them (`camera_hits`: filled in place).
-fn packet_prims(scene: &Scene, (rays, active): &(RayPacket, u32)) -> usize {
-    let mut h = PacketHits::default();
-    scene.intersect8_into(rays, *active, &mut h);
+/// The camera packet's hits, traced as the renderer traces them: into hits reused from
+/// packet to packet (`LaneScratch`).
+fn packet_prims(scene: &Scene, (rays, active): &(RayPacket, u32), h: &mut PacketHits) -> usize {
+    scene.intersect8_into(rays, *active, h);
     (0..LANES).map(|i| prim(h.get(i))).sum()
 }
 
@@ -332,12 +332,12 @@ fn trace_in_order<'a>(
     chunks: impl Iterator<Item = &'a [Packets]>,
 ) -> (usize, f64) {
     let (mut sink, mut seconds) = (0, 0.0);
-    let mut warm = Warm::default();
+    let (mut warm, mut hits) = (Warm::default(), PacketHits::default());
     for chunk in chunks {
         let w = warm.load(mix, chunk);
         let t = Instant::now();
         for (p, b) in w.packets.iter().zip(&w.bsdf_packets) {
-            sink += packet_prims(scene, &p.camera);
+            sink += packet_prims(scene, &p.camera, &mut hits);
             sink += scene.accel.occluded8(&p.shadow.0, p.shadow.1) as usize;
             sink += bsdf_queries(scene, b);
         }

@@ -270,10 +270,10 @@ impl Accel {
         out
     }
 
-    /// `intersect` for each ray set in `active`, traced as one packet, into `out`, which
-    /// must hold `PacketHits::default()`. Returned by value, the 484-byte hits were copied
-    /// out by a `memcpy` call on every packet (LLVM did not build them in place, even
-    /// inlined): 0.8-1.1 % of a Veach render's time (perf).
+    /// `intersect` for each ray set in `active`, traced as one packet, into `out` (all of it
+    /// overwritten). Returned by value, the 484-byte hits were copied out by a `memcpy` call
+    /// on every packet (LLVM did not build them in place, even inlined): 0.8-1.1 % of a
+    /// Veach render's time (perf).
     pub fn intersect8_into(
         &self,
         rays: &RayPacket,
@@ -281,6 +281,7 @@ impl Accel {
         shapes: &[Shape],
         out: &mut PacketHits,
     ) {
+        *out = PacketHits::default();
         if active.count_ones() <= 1 {
             for i in bits(active) {
                 if let Some(hit) = self.intersect(&rays.ray(i), shapes) {

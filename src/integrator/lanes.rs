@@ -243,6 +243,8 @@ pub(super) struct Shaded {
 /// what it reads; the fields some batches write only in part are cleared per batch.
 #[derive(Default)]
 pub struct LaneScratch {
+    /// The camera packet's hits, filled in place (`Accel::intersect8_into`).
+    packet: PacketHits,
     hits: CameraHits,
     draws: LightDraws,
     shaded: Shaded,
@@ -265,6 +267,7 @@ impl Direct<'_> {
             });
         };
         let LaneScratch {
+            packet,
             hits,
             draws,
             shaded,
@@ -276,7 +279,10 @@ impl Direct<'_> {
         // 64-bit multiplications (about 15 cycles each) started only once traversal ended.
         let at_hit = rng.clone();
         let u: [[f32; LANES]; 7] = std::array::from_fn(|_| rng.next_f32());
-        self.camera_hits(&lanes.shapes, rays, n, &at_hit, &mut out, hits);
+        // Into hits reused from batch to batch: a returned `PacketHits` was copied out by a
+        // `memcpy` call.
+        self.scene.intersect8_into(rays, (1 << n) - 1, packet);
+        self.camera_hits(&lanes.shapes, rays, packet, &at_hit, &mut out, hits);
         let mut spheres = SphereDraws::default();
         let small = lanes.small_lights.as_deref();
         self.light_draws(&lanes.lights, small, &u[0], &u[1], draws, &mut spheres);
@@ -298,21 +304,19 @@ impl Direct<'_> {
         self.lanes.is_some()
     }
 
-    /// Camera hits; lanes the kernel does not cover are finished here by `li_hit`.
+    /// The camera rays' hits into lanes; lanes the kernel does not cover are finished here
+    /// by `li_hit`.
     #[inline(always)]
     fn camera_hits(
         &self,
         shapes: &[LaneShape],
         rays: &RayPacket,
-        n: usize,
+        camera: &PacketHits,
         rng: &RngLanes,
         out: &mut [Rgb; LANES],
         h: &mut CameraHits,
     ) {
         let scene = self.scene;
-        // Filled in place: a returned `PacketHits` was copied by a `memcpy` call.
-        let mut camera = PacketHits::default();
-        scene.intersect8_into(rays, (1 << n) - 1, &mut camera);
         // What the paths below write for some lanes only, or not at all.
         (h.le, h.covered) = (V3x8::default(), 0);
         // Taken whole; lanes the loop below does not cover are dropped later.
@@ -321,16 +325,13 @@ impl Direct<'_> {
         h.ns = V3x8::from_axes(camera.ns);
         h.err = V3x8::from_axes(camera.err);
         h.d = V3x8::from_axes(rays.d);
-        if let Some(shape) = one_shape(shapes, &camera) {
-            if self.fill_one_shape(shape, &camera, rays, h) {
+        if let Some(shape) = one_shape(shapes, camera) {
+            if self.fill_one_shape(shape, camera, rays, h) {
                 return;
             }
         }
         let mut batch = None;
-        for i in 0..n {
-            if camera.mask >> i & 1 == 0 {
-                continue;
-            }
+        for i in bits(camera.mask) {
             let (shape_id, prim) = (camera.shape[i], camera.prim[i]);
             let shape = &shapes[shape_id as usize];
             // The batch takes the kind of its first covered hit; hits of the other kind (at a
