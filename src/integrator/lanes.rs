@@ -279,8 +279,6 @@ impl Direct<'_> {
         // 64-bit multiplications (about 15 cycles each) started only once traversal ended.
         let at_hit = rng.clone();
         let u: [[f32; LANES]; 7] = std::array::from_fn(|_| rng.next_f32());
-        // Into hits reused from batch to batch: a returned `PacketHits` was copied out by a
-        // `memcpy` call.
         self.scene.intersect8_into(rays, (1 << n) - 1, packet);
         self.camera_hits(&lanes.shapes, rays, packet, &at_hit, &mut out, hits);
         let mut spheres = SphereDraws::default();
