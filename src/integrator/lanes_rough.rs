@@ -10,7 +10,8 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::direct::{heuristic, Direct};
-use super::lanes::{light_sample, CameraHits, LightDraws, Shaded, SphereDraws, V3x8};
+use super::lanes::{CameraHits, Shaded, V3x8};
+use super::lanes_light::{light_sample, LightDraws, SphereDraws};
 use crate::bsdf::fresnel::fresnel_conductor_channel;
 use crate::bsdf::RoughConductor;
 use crate::math::{offset_origin, Frame, Rgb};

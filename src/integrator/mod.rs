@@ -3,6 +3,7 @@
 mod direct;
 mod lane_tables;
 mod lanes;
+mod lanes_light;
 mod lanes_rough;
 mod strategy;
 
