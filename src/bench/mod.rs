@@ -56,6 +56,12 @@ pub struct BenchArgs {
     pub out: PathBuf,
 }
 
+/// The estimator the goals are stated for, and the first of `bench_strategies`: power-heuristic
+/// MIS with one light and one BSDF sample, uniform emitter choice, area sampling.
+pub fn power_mis() -> Strategy {
+    bench_strategies()[0]
+}
+
 /// The strategies whose throughput is reported: the study's and the usual MIS settings.
 pub fn bench_strategies() -> Vec<Strategy> {
     let base = Strategy {
@@ -182,7 +188,7 @@ fn ray_limit_section(
     max_threads: usize,
     rows: &mut Vec<Row>,
 ) {
-    let mis = bench_strategies()[0];
+    let mis = power_mis();
     // The ray-tracing limit for the same ray mix, on one thread, against the 1-thread
     // render time of power MIS (which traces that mix). Whole groups of LANES samples per
     // pixel, as the renderer traces them.

@@ -608,7 +608,7 @@ mod tests {
         );
         (d.film.width, d.film.height) = (6, BAND_ROWS + 3);
         let scene = Scene::build(d).expect("fixture scene");
-        let mis = crate::bench::bench_strategies()[0];
+        let mis = crate::bench::power_mis();
         let direct = crate::integrator::Direct::new(&scene, mis);
         let mix = ray_mix(&scene, 8, mis.selection);
         for threads in [1, 2] {

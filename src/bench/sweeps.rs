@@ -2,7 +2,7 @@
 //! `scaling`, and the emitter choice alone.
 
 use super::throughput::throughput;
-use super::{bench_strategies, least, paired_ratio, scaling, BenchArgs, Row};
+use super::{least, paired_ratio, power_mis, scaling, BenchArgs, Row};
 use crate::emitter::EmitterSelection;
 use crate::integrator::Strategy;
 use crate::scene::Scene;
@@ -13,7 +13,7 @@ pub(super) fn section(
     max_threads: usize,
     rows: &mut Vec<Row>,
 ) -> Result<(), String> {
-    let mis = bench_strategies()[0];
+    let mis = power_mis();
     println!(
         "per-sample cost as the scene grows ({} threads, power MIS, 64x64 at {} spp, best of {}):",
         max_threads, a.sweep_spp, a.repeat

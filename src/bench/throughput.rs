@@ -1,7 +1,7 @@
 //! Render throughput of every strategy at every thread count, the speed-up from the fewest
 //! to the most threads, and the machine's own limit for that speed-up (`copies`).
 
-use super::{bench_strategies, copies, least, paired_ratio, BenchArgs, Row};
+use super::{bench_strategies, copies, least, paired_ratio, power_mis, BenchArgs, Row};
 use crate::integrator::Strategy;
 use crate::render::{render, RenderSettings};
 use crate::scene::Scene;
@@ -79,7 +79,7 @@ pub(super) fn section(scene: &Scene, name: &str, a: &BenchArgs, rows: &mut Vec<R
             }
         }
     }
-    let mis = bench_strategies()[0];
+    let mis = power_mis();
     if let Some((t2, speed_up)) = first_speed_up {
         let c = copies::measure(scene, mis, a.spp, t2, a.repeat);
         println!(
