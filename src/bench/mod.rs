@@ -7,7 +7,7 @@
 //! emitter counts grow (`sweeps`, over the scenes of `scaling`); peak memory.
 mod copies;
 mod raylimit;
-mod scaling;
+pub(crate) mod scaling;
 mod sweeps;
 mod throughput;
 

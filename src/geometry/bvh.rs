@@ -41,7 +41,13 @@ pub struct WideBvh {
     leaves: Vec<(u32, u32)>,
     /// Stack entries a traversal may need: W - 1 per level below the root, plus one.
     pub(super) stack_need: usize,
+    /// Whether the packet traversals' callers prefetch entered children (`Accel::prefetch`):
+    /// for trees larger than the caches near the core.
+    pub(super) prefetch: bool,
 }
+
+/// Nodes above which a tree prefetches (about 450 kB of nodes).
+const PREFETCH_NODES: usize = 2048;
 
 /// Per-ray data of the box test.
 struct BoxRay {
@@ -164,6 +170,7 @@ impl WideBvh {
             bounds: (Vec3A::INFINITY, Vec3A::NEG_INFINITY),
             leaves: Vec::new(),
             stack_need: 1,
+            prefetch: false,
         }
     }
 
@@ -175,6 +182,7 @@ impl WideBvh {
         }
         let depth = out.collapse(bvh, 0, true);
         out.stack_need = (W - 1) * depth + 1;
+        out.prefetch = out.nodes.len() > PREFETCH_NODES;
         let Aabb { min, max } = *bvh.nodes[0].aabb();
         out.bounds = (min, max);
         out
