@@ -5,6 +5,7 @@
 //! share of render time spent outside traversal, on one thread and on the most threads
 //! (`ray_limit_section` here, measured by `raylimit`); per-sample cost as the triangle and
 //! emitter counts grow (`sweeps`, over the scenes of `scaling`); peak memory.
+
 mod copies;
 mod raylimit;
 pub(crate) mod scaling;

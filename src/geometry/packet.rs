@@ -102,7 +102,7 @@ impl WideBvh {
     /// `closest` for the rays set in `active`: on return `tmax[i]` is ray i's closest hit
     /// distance if it has one. `leaf(l, mask, tmax)` tests leaf `l` against the rays in
     /// `mask`, lowering their `tmax` to the hits it finds. `hint(c)` is told of every child
-    /// slot pushed for a later visit (for prefetching).
+    /// slot it pushes, the next one visited included (for prefetching).
     #[inline(always)]
     pub fn closest8<F: FnMut(usize, u32, &mut [f32; PACKET])>(
         &self,
