@@ -29,34 +29,6 @@ pub(super) struct Leaf {
     pub(super) spheres: (u32, u32),
 }
 
-impl Accel {
-    /// Asks for the node or leaf of child `c` (a `WideBvh` child slot) that a packet traversal
-    /// has just put on its stack, where the tree is larger than the caches near the core: its
-    /// loads then overlap the subtree visited first instead of stalling when it is popped.
-    /// On the 1e6-triangle sweep scene, 7-9 % less time per sample (1 thread); a leaf's record
-    /// (176 bytes) was the traversal's largest stall there.
-    #[inline(always)]
-    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))]
-    pub(super) fn prefetch(&self, c: u32) {
-        #[cfg(target_arch = "x86_64")]
-        if self.bvh.prefetch {
-            use super::bvh::{Node, LEAF};
-            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            let (p, size) = if c & LEAF == 0 {
-                let p = self.bvh.nodes.as_ptr().wrapping_add(c as usize) as *const i8;
-                (p, std::mem::size_of::<Node>())
-            } else {
-                let p = self.leaves.as_ptr().wrapping_add((c & !LEAF) as usize) as *const i8;
-                (p, std::mem::size_of::<Leaf>())
-            };
-            for line in 0..size.div_ceil(64) {
-                // SAFETY: a prefetch never faults, whatever the address.
-                unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * line)) };
-            }
-        }
-    }
-}
-
 impl Leaf {
     /// The lanes holding triangle `id`.
     #[inline(always)]
@@ -287,6 +259,32 @@ impl Accel {
             t,
             sp: surface_point(shapes, prim, best.1, ray, t),
         })
+    }
+
+    /// Asks for the node or leaf of child `c` (a `WideBvh` child slot) that a packet traversal
+    /// has just put on its stack, where the tree is larger than the caches near the core: its
+    /// loads then overlap the subtree visited first instead of stalling when it is popped.
+    /// On the 1e6-triangle sweep scene, 7-9 % less time per sample (1 thread); a leaf's record
+    /// (176 bytes) was the traversal's largest stall there.
+    #[inline(always)]
+    #[cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))]
+    pub(super) fn prefetch(&self, c: u32) {
+        #[cfg(target_arch = "x86_64")]
+        if self.bvh.prefetches() {
+            use super::bvh::{Node, LEAF};
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let (p, size) = if c & LEAF == 0 {
+                let p = self.bvh.nodes.as_ptr().wrapping_add(c as usize) as *const i8;
+                (p, std::mem::size_of::<Node>())
+            } else {
+                let p = self.leaves.as_ptr().wrapping_add((c & !LEAF) as usize) as *const i8;
+                (p, std::mem::size_of::<Leaf>())
+            };
+            for line in 0..size.div_ceil(64) {
+                // SAFETY: a prefetch never faults, whatever the address.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * line)) };
+            }
+        }
     }
 
     /// The box around everything in the structure.

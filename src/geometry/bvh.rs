@@ -41,9 +41,6 @@ pub struct WideBvh {
     leaves: Vec<(u32, u32)>,
     /// Stack entries a traversal may need: W - 1 per level below the root, plus one.
     pub(super) stack_need: usize,
-    /// Whether the packet traversals' callers prefetch entered children (`Accel::prefetch`):
-    /// for trees larger than the caches near the core.
-    pub(super) prefetch: bool,
 }
 
 /// Nodes above which a tree prefetches (about 450 kB of nodes).
@@ -170,8 +167,14 @@ impl WideBvh {
             bounds: (Vec3A::INFINITY, Vec3A::NEG_INFINITY),
             leaves: Vec::new(),
             stack_need: 1,
-            prefetch: false,
         }
+    }
+
+    /// Whether the packet traversals' callers prefetch entered children (`Accel::prefetch`):
+    /// for trees larger than the caches near the core.
+    #[inline(always)]
+    pub(super) fn prefetches(&self) -> bool {
+        self.nodes.len() > PREFETCH_NODES
     }
 
     /// Collapses a binary BVH. Leaves are numbered in the order `leaves()` lists them.
@@ -182,7 +185,6 @@ impl WideBvh {
         }
         let depth = out.collapse(bvh, 0, true);
         out.stack_need = (W - 1) * depth + 1;
-        out.prefetch = out.nodes.len() > PREFETCH_NODES;
         let Aabb { min, max } = *bvh.nodes[0].aabb();
         out.bounds = (min, max);
         out

@@ -586,7 +586,7 @@ mod tests {
             );
             assert_eq!(smooth_meshes.count() > 0, smooth, "{path}");
             let accel = &scene.accel;
-            assert_eq!(accel.bvh.prefetch, path == big, "{path}");
+            assert_eq!(accel.bvh.prefetches(), path == big, "{path}");
             let shapes = &scene.shapes;
             let (lo, hi) = accel.bounds();
             let mut rng = Rng::new(9, 9);
