@@ -67,19 +67,29 @@ impl V3x8 {
         [self.x, self.y, self.z]
     }
 
+    /// Copies the components from a ray packet's layout, axis by axis: built as a whole
+    /// value, the copy went through a stack temporary whose 32-byte stores were read back
+    /// as 64-byte loads, which cannot be forwarded from them (a stall of each copy).
     #[inline(always)]
-    fn from_axes([x, y, z]: [[f32; LANES]; 3]) -> Self {
-        V3x8 { x, y, z }
+    fn copy_axes(&mut self, [x, y, z]: &[[f32; LANES]; 3]) {
+        (self.x, self.y, self.z) = (*x, *y, *z);
     }
+}
+
+/// Lane i of eight 3-vectors in a packet's layout.
+#[inline(always)]
+fn at(v: &[[f32; LANES]; 3], i: usize) -> Vec3 {
+    Vec3::new(v[0][i], v[1][i], v[2][i])
 }
 
 /// What the camera hits of the eight samples leave for shading.
 #[derive(Default)]
 pub(super) struct CameraHits {
-    pub(super) p: V3x8,
-    pub(super) ng: V3x8,
-    pub(super) ns: V3x8,
-    pub(super) err: V3x8,
+    /// The camera packet's hits, filled in place (`Accel::intersect8_into`) and read where
+    /// they lie: a copy of their points and normals into lane arrays stalled on the
+    /// traversal's last stores, one lane wide, which a wide load cannot take forwarded
+    /// (about a third of `li_lanes`'s own time on the Veach scene, perf).
+    camera: PacketHits,
     /// Camera ray direction.
     pub(super) d: V3x8,
     /// Diffuse reflectance, or a rough conductor's specular reflectance.
@@ -97,6 +107,28 @@ pub(super) struct CameraHits {
     /// The lanes shaded here, and their estimate so far (the emission seen at the hit).
     pub(super) covered: u32,
     le: V3x8,
+}
+
+impl CameraHits {
+    #[inline(always)]
+    pub(super) fn p(&self, i: usize) -> Vec3 {
+        at(&self.camera.p, i)
+    }
+
+    #[inline(always)]
+    pub(super) fn ng(&self, i: usize) -> Vec3 {
+        at(&self.camera.ng, i)
+    }
+
+    #[inline(always)]
+    pub(super) fn ns(&self, i: usize) -> Vec3 {
+        at(&self.camera.ns, i)
+    }
+
+    #[inline(always)]
+    pub(super) fn err(&self, i: usize) -> Vec3 {
+        at(&self.camera.err, i)
+    }
 }
 
 /// The lanes' rays and candidate contributions, before visibility. Every shading pass writes
@@ -120,8 +152,6 @@ pub(super) struct Shaded {
 /// what it reads; the fields some batches write only in part are cleared per batch.
 #[derive(Default)]
 pub struct LaneScratch {
-    /// The camera packet's hits, filled in place (`Accel::intersect8_into`).
-    packet: PacketHits,
     hits: CameraHits,
     draws: LightDraws,
     shaded: Shaded,
@@ -130,6 +160,7 @@ pub struct LaneScratch {
 impl Direct<'_> {
     /// `li` of the first `n` rays, each with its lane of `rng` (which must stand where `li`
     /// would receive it): in lanes where they cover the scene and strategy, else one by one.
+    #[inline(always)]
     pub fn li_lanes(
         &self,
         rays: &RayPacket,
@@ -144,7 +175,6 @@ impl Direct<'_> {
             });
         };
         let LaneScratch {
-            packet,
             hits,
             draws,
             shaded,
@@ -156,8 +186,9 @@ impl Direct<'_> {
         // 64-bit multiplications (about 15 cycles each) started only once traversal ended.
         let at_hit = rng.clone();
         let u: [[f32; LANES]; 7] = std::array::from_fn(|_| rng.next_f32());
-        self.scene.intersect8_into(rays, (1 << n) - 1, packet);
-        self.camera_hits(&lanes.shapes, rays, packet, &at_hit, &mut out, hits);
+        self.scene
+            .intersect8_into(rays, (1 << n) - 1, &mut hits.camera);
+        self.camera_hits(&lanes.shapes, rays, &at_hit, &mut out, hits);
         let mut spheres = SphereDraws::default();
         let small = lanes.small_lights.as_deref();
         self.light_draws(&lanes.lights, small, &u[0], &u[1], draws, &mut spheres);
@@ -186,7 +217,6 @@ impl Direct<'_> {
         &self,
         shapes: &[LaneShape],
         rays: &RayPacket,
-        camera: &PacketHits,
         rng: &RngLanes,
         out: &mut [Rgb; LANES],
         h: &mut CameraHits,
@@ -195,16 +225,13 @@ impl Direct<'_> {
         // What the paths below write for some lanes only, or not at all.
         (h.le, h.covered) = (V3x8::default(), 0);
         // Taken whole; lanes the loop below does not cover are dropped later.
-        h.p = V3x8::from_axes(camera.p);
-        h.ng = V3x8::from_axes(camera.ng);
-        h.ns = V3x8::from_axes(camera.ns);
-        h.err = V3x8::from_axes(camera.err);
-        h.d = V3x8::from_axes(rays.d);
-        if let Some(shape) = one_shape(shapes, camera) {
-            if self.fill_one_shape(shape, camera, rays, h) {
+        h.d.copy_axes(&rays.d);
+        if let Some(shape) = one_shape(shapes, &h.camera) {
+            if self.fill_one_shape(shape, rays, h) {
                 return;
             }
         }
+        let camera = &h.camera;
         let mut batch = None;
         for i in bits(camera.mask) {
             let (shape_id, prim) = (camera.shape[i], camera.prim[i]);
@@ -252,13 +279,8 @@ impl Direct<'_> {
     /// at once: helpers shared with the loop, per lane or per lane mask, cost the Cornell box
     /// 0.8-2.1 % more instructions (callgrind).
     #[inline(always)]
-    fn fill_one_shape(
-        &self,
-        shape: &LaneShape,
-        camera: &PacketHits,
-        rays: &RayPacket,
-        h: &mut CameraHits,
-    ) -> bool {
+    fn fill_one_shape(&self, shape: &LaneShape, rays: &RayPacket, h: &mut CameraHits) -> bool {
+        let camera = &h.camera;
         // Lanes without a hit take the row too: their samples are computed and dropped.
         h.rough = match shape.material {
             LaneMaterial::Diffuse(reflectance) => {
@@ -340,8 +362,8 @@ impl Direct<'_> {
         let s = &self.strategy;
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
         for i in 0..LANES {
-            let (p, ng, err) = (h.p.get(i), h.ng.get(i), h.err.get(i));
-            let frame = Frame::from_normal(h.ns.get(i));
+            let (p, ng, err) = (h.p(i), h.ng(i), h.err(i));
+            let frame = Frame::from_normal(h.ns(i));
             let wi = frame.to_local(-h.d.get(i));
             let diffuse = Diffuse {
                 reflectance: h.reflectance.get(i),
@@ -412,7 +434,7 @@ impl Direct<'_> {
                     pdf: sh.bsdf_pdf[i],
                     delta: false,
                 };
-                bsdf.set(i, self.bsdf_emission(h.p.get(i), ray.d, &hit, &bs, bsdf_w));
+                bsdf.set(i, self.bsdf_emission(h.p(i), ray.d, &hit, &bs, bsdf_w));
             }
         }
         // `li`'s sum, in its order, for all lanes at once; only covered lanes are kept.

@@ -79,14 +79,14 @@ impl Direct<'_> {
         let mut wi_local = V3x8::default();
         let mut lambda_i = [0.0f32; LANES];
         for i in 0..LANES {
-            let (p, ng, err) = (h.p.get(i), h.ng.get(i), h.err.get(i));
+            let (p, ng, err) = (h.p(i), h.ng(i), h.err(i));
             let (drawn, wl, pdf_area, radiance, lsp) = light_sample::<true>(p, ld, sd, u, i);
             let lp = lsp.p;
             let so = offset_origin(p, ng, err, lp - p);
             o.shadow_o.set(i, so);
             o.shadow_target
                 .set(i, offset_origin(lp, lsp.ng, lsp.err_scale, so - lp));
-            let frame = Frame::from_normal(h.ns.get(i));
+            let frame = Frame::from_normal(h.ns(i));
             let wi = frame.to_local(-h.d.get(i));
             let rc = h.rough_conductor(i);
             // Smith's Lambda(wi), once for both samples' evaluations.
@@ -140,7 +140,7 @@ impl Direct<'_> {
             }
         }
         for i in 0..LANES {
-            let (p, ng, err) = (h.p.get(i), h.ng.get(i), h.err.get(i));
+            let (p, ng, err) = (h.p(i), h.ng(i), h.err(i));
             let rc = h.rough_conductor(i);
             let wi = wi_local.get(i);
             let m = rc.mf.beckmann_visible_end(&vis.get(i));
@@ -153,7 +153,7 @@ impl Direct<'_> {
             o.bsdf_ok[i] = ok;
             o.bsdf_pdf[i] = pdf;
             o.bsdf_weight.set(i, weight);
-            let d = Frame::from_normal(h.ns.get(i)).to_world(wo);
+            let d = Frame::from_normal(h.ns(i)).to_world(wo);
             o.bsdf_d.set(i, d);
             o.bsdf_o.set(i, offset_origin(p, ng, err, d));
         }
