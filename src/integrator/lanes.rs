@@ -24,7 +24,7 @@ use super::lane_tables::{LaneMaterial, LaneShape};
 use super::lanes_light::{light_sample, LightDraws, SphereDraws};
 use crate::bsdf::{BsdfSample, Diffuse};
 use crate::geometry::packet::bits;
-use crate::geometry::{Accel, PacketHits, RayPacket};
+use crate::geometry::{Accel, PacketHits, Ray, RayPacket};
 use crate::math::{offset_origin, Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
 use crate::scene::Scene;
@@ -62,7 +62,7 @@ impl V3x8 {
     }
 
     /// The components as a ray packet holds them.
-    #[inline(always)]
+    #[cfg(test)]
     pub(super) fn axes(&self) -> [[f32; LANES]; 3] {
         [self.x, self.y, self.z]
     }
@@ -102,7 +102,7 @@ pub(super) struct CameraHits {
     pub(super) eta: [f32; LANES],
     pub(super) k: [f32; LANES],
     /// Accelerator skip ids of the hit triangle (all rays, emitter-only structure).
-    skip: [u32; LANES],
+    pub(super) skip: [u32; LANES],
     emitter_skip: [u32; LANES],
     /// The lanes shaded here, and their estimate so far (the emission seen at the hit).
     pub(super) covered: u32,
@@ -135,12 +135,13 @@ impl CameraHits {
 /// every field of every lane.
 #[derive(Default)]
 pub(super) struct Shaded {
-    pub(super) shadow_o: V3x8,
-    pub(super) shadow_target: V3x8,
+    /// The shadow and BSDF rays, made in the packets that are traced: made in lane arrays
+    /// and copied into packets, their copies stalled as the camera hits' did (see
+    /// `CameraHits::camera`).
+    pub(super) shadow: RayPacket,
     pub(super) light: V3x8,
     pub(super) light_ok: [bool; LANES],
-    pub(super) bsdf_o: V3x8,
-    pub(super) bsdf_d: V3x8,
+    pub(super) bsdf: RayPacket,
     pub(super) bsdf_pdf: [f32; LANES],
     pub(super) bsdf_weight: V3x8,
     pub(super) bsdf_ok: [bool; LANES],
@@ -378,9 +379,9 @@ impl Direct<'_> {
             o.light_ok[i] = drawn && f != Rgb::ZERO && radiance != Rgb::ZERO;
             let lp = lsp.p;
             let so = offset_origin(p, ng, err, lp - p);
-            o.shadow_o.set(i, so);
-            o.shadow_target
-                .set(i, offset_origin(lp, lsp.ng, lsp.err_scale, so - lp));
+            let target = offset_origin(lp, lsp.ng, lsp.err_scale, so - lp);
+            o.shadow
+                .set(i, &Scene::shadow_ray_to(so, target, h.skip[i]));
             // BSDF sample and `Scene::bsdf_ray`'s origin.
             let bs = diffuse.sample(wi, Vec2::new(u[5][i], u[6][i]));
             let (bsdf_ok, wo, pdf) = match bs {
@@ -391,8 +392,8 @@ impl Direct<'_> {
             o.bsdf_pdf[i] = pdf;
             o.bsdf_weight.set(i, diffuse.reflectance);
             let d = frame.to_world(wo);
-            o.bsdf_d.set(i, d);
-            o.bsdf_o.set(i, offset_origin(p, ng, err, d));
+            o.bsdf
+                .set(i, &bsdf_ray(offset_origin(p, ng, err, d), d, h.skip[i]));
         }
     }
 
@@ -411,21 +412,14 @@ impl Direct<'_> {
         let bsdf_w = |pb, pl| heuristic(s.heuristic, nb * pb, ne * pl);
         // Every lane's ray is computed; only those of covered lanes with a light sample
         // are traced.
-        let shadow = Scene::shadow_rays_to(&sh.shadow_o.axes(), &sh.shadow_target.axes(), &h.skip);
         let traced = h.covered & mask_of(&sh.light_ok);
-        let blocked = scene.accel.occluded8(&shadow, traced);
+        let blocked = scene.accel.occluded8(&sh.shadow, traced);
         // The BSDF rays, put through `bsdf_ray_hit`'s reject in lanes (without sphere lights,
         // its box reject alone): only those it lets through are traced, one by one.
-        let bsdf_rays = RayPacket {
-            o: sh.bsdf_o.axes(),
-            d: sh.bsdf_d.axes(),
-            tmin: [0.0; LANES],
-            tmax: [f32::INFINITY; LANES],
-            skip: h.skip,
-        };
+        let bsdf_rays = &sh.bsdf;
         let open = h.covered & mask_of(&sh.bsdf_ok);
         let mut bsdf = V3x8::default();
-        for i in bits(scene.bsdf_rays_may_hit::<SPHERES>(&bsdf_rays, open)) {
+        for i in bits(scene.bsdf_rays_may_hit::<SPHERES>(bsdf_rays, open)) {
             let ray = bsdf_rays.ray(i);
             if let Some(hit) = scene.bsdf_ray_hit_traced(&ray, h.emitter_skip[i]) {
                 let bs = BsdfSample {
@@ -463,6 +457,16 @@ fn one_shape<'s>(shapes: &'s [LaneShape], camera: &PacketHits) -> Option<&'s Lan
         same |= ((camera.shape[i] == first) as u32) << i;
     }
     (same & camera.mask == camera.mask).then(|| &shapes[first as usize])
+}
+
+/// A lane's BSDF ray as the lane kernel traces it: from origin `o`, unbounded, skipping the
+/// hit triangle `skip` of the main structure.
+#[inline(always)]
+pub(super) fn bsdf_ray(o: Vec3, d: Vec3, skip: u32) -> Ray {
+    Ray {
+        skip,
+        ..Ray::new(o, d)
+    }
 }
 
 /// The lanes whose flag is set, as a mask.

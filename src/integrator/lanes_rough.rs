@@ -10,7 +10,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::direct::{heuristic, Direct};
-use super::lanes::{CameraHits, Shaded, V3x8};
+use super::lanes::{bsdf_ray, CameraHits, Shaded, V3x8};
 use super::lanes_light::{light_sample, LightDraws, SphereDraws};
 use crate::bsdf::fresnel::fresnel_conductor_channel;
 use crate::bsdf::RoughConductor;
@@ -20,6 +20,7 @@ use crate::sampling::microfacet::{
     beckmann_visible_y, slope_step, BeckmannVisible, Microfacet, MicrofacetDistribution,
     SlopeInversion,
 };
+use crate::scene::Scene;
 use glam::Vec3;
 
 impl CameraHits {
@@ -83,9 +84,9 @@ impl Direct<'_> {
             let (drawn, wl, pdf_area, radiance, lsp) = light_sample::<true>(p, ld, sd, u, i);
             let lp = lsp.p;
             let so = offset_origin(p, ng, err, lp - p);
-            o.shadow_o.set(i, so);
-            o.shadow_target
-                .set(i, offset_origin(lp, lsp.ng, lsp.err_scale, so - lp));
+            let target = offset_origin(lp, lsp.ng, lsp.err_scale, so - lp);
+            o.shadow
+                .set(i, &Scene::shadow_ray_to(so, target, h.skip[i]));
             let frame = Frame::from_normal(h.ns(i));
             let wi = frame.to_local(-h.d.get(i));
             let rc = h.rough_conductor(i);
@@ -154,8 +155,8 @@ impl Direct<'_> {
             o.bsdf_pdf[i] = pdf;
             o.bsdf_weight.set(i, weight);
             let d = Frame::from_normal(h.ns(i)).to_world(wo);
-            o.bsdf_d.set(i, d);
-            o.bsdf_o.set(i, offset_origin(p, ng, err, d));
+            o.bsdf
+                .set(i, &bsdf_ray(offset_origin(p, ng, err, d), d, h.skip[i]));
         }
     }
 }

@@ -7,7 +7,6 @@ use crate::bsdf::{
 };
 use crate::camera::Camera;
 use crate::emitter::{AreaLight, Emitter, LightSample, PointLight};
-use crate::geometry::packet::PACKET;
 use crate::geometry::{
     Accel, Hit, Mesh, PacketHits, Ray, RayPacket, Shape, ShapeKind, Sphere, SurfacePoint, NO_SKIP,
 };
@@ -424,28 +423,6 @@ impl Scene {
             tmin: 0.0,
             tmax: SHADOW_TMAX,
             skip,
-        }
-    }
-
-    /// `shadow_ray_to` in each lane, from origins and targets given one array per axis.
-    #[inline(always)]
-    pub fn shadow_rays_to(
-        o: &[[f32; PACKET]; 3],
-        target: &[[f32; PACKET]; 3],
-        skip: &[u32; PACKET],
-    ) -> RayPacket {
-        let mut d = [[0.0; PACKET]; 3];
-        for a in 0..3 {
-            for i in 0..PACKET {
-                d[a][i] = target[a][i] - o[a][i];
-            }
-        }
-        RayPacket {
-            o: *o,
-            d,
-            tmin: [0.0; PACKET],
-            tmax: [SHADOW_TMAX; PACKET],
-            skip: *skip,
         }
     }
 
