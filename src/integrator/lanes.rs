@@ -161,6 +161,10 @@ pub struct LaneScratch {
 impl Direct<'_> {
     /// `li` of the first `n` rays, each with its lane of `rng` (which must stand where `li`
     /// would receive it): in lanes where they cover the scene and strategy, else one by one.
+    ///
+    /// Inlined into `render_pixel`: called, it read the lanes' generator states (left by the
+    /// camera's draws half in one 32-byte store, half in 8-byte ones) and returned the
+    /// estimates through memory, both read back at once by loads too wide to be forwarded.
     #[inline(always)]
     pub fn li_lanes(
         &self,
