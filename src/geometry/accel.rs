@@ -18,6 +18,13 @@ const LEAF_SIZE: usize = 4;
 /// 1e5 about 7 % and 1e6 about 11 % less time per sample.
 const FULL_LEAVES_FROM: usize = 10_000;
 
+/// Primitive count above which the binary BVH is built with obvhs's slow preset (wider PLOC
+/// search, more reinsertion). The bench's tessellated sphere, 1 thread, five pairs of sweeps
+/// side by side on the two cores: at 1e6 triangles 0.86-0.96x the time per sample (median
+/// 0.88x, all five pairs), for a build of 1.64 s instead of 0.63 s; at 1e5 no gain (median
+/// 1.03x, 2 of 5 pairs), so the switch sits between the two.
+const QUALITY_BUILD_FROM: usize = 300_000;
+
 /// One BVH leaf: its triangles as a packet and its spheres.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Leaf {
@@ -140,7 +147,13 @@ impl Accel {
             } else {
                 1.0
             },
-            ..BvhBuildParams::medium_build()
+            // A large tree's traversal waits on memory, where a tree with fewer and better
+            // placed nodes pays for its slower build (see `QUALITY_BUILD_FROM`).
+            ..if prims.len() > QUALITY_BUILD_FROM {
+                BvhBuildParams::slow_build()
+            } else {
+                BvhBuildParams::medium_build()
+            }
         };
         let bvh2 = build_bvh2(&aabbs, params, &mut Duration::default());
         accel.bvh = WideBvh::from_bvh2(&bvh2);
