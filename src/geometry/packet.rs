@@ -566,9 +566,10 @@ mod tests {
             (cbox, true),
             (big, false),
         ] {
-            let mut desc = match path {
-                _ if path == big => crate::bench::scaling::tessellated(100_000),
-                _ => crate::scene::load_scene(std::path::Path::new(path), &[]).expect(path),
+            let mut desc = if path == big {
+                crate::bench::scaling::tessellated(100_000)
+            } else {
+                crate::scene::load_scene(std::path::Path::new(path), &[]).expect(path)
             };
             if smooth {
                 for shape in desc.shapes.iter_mut().step_by(2) {

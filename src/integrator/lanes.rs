@@ -24,8 +24,8 @@ use super::lane_tables::{LaneMaterial, LaneShape};
 use super::lanes_light::{light_sample, LightDraws, SphereDraws};
 use crate::bsdf::{BsdfSample, Diffuse};
 use crate::geometry::packet::bits;
-use crate::geometry::{Accel, PacketHits, Ray, RayPacket};
-use crate::math::{offset_origin, Frame, Rgb};
+use crate::geometry::{Accel, PacketHits, RayPacket};
+use crate::math::{Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
@@ -76,12 +76,6 @@ impl V3x8 {
     }
 }
 
-/// Lane i of eight 3-vectors in a packet's layout.
-#[inline(always)]
-fn at(v: &[[f32; LANES]; 3], i: usize) -> Vec3 {
-    Vec3::new(v[0][i], v[1][i], v[2][i])
-}
-
 /// What the camera hits of the eight samples leave for shading.
 #[derive(Default)]
 pub(super) struct CameraHits {
@@ -89,7 +83,7 @@ pub(super) struct CameraHits {
     /// they lie: a copy of their points and normals into lane arrays stalled on the
     /// traversal's last stores, one lane wide, which a wide load cannot take forwarded
     /// (about a third of `li_lanes`'s own time on the Veach scene, perf).
-    camera: PacketHits,
+    pub(super) camera: PacketHits,
     /// Camera ray direction.
     pub(super) d: V3x8,
     /// Diffuse reflectance, or a rough conductor's specular reflectance.
@@ -107,28 +101,6 @@ pub(super) struct CameraHits {
     /// The lanes shaded here, and their estimate so far (the emission seen at the hit).
     pub(super) covered: u32,
     le: V3x8,
-}
-
-impl CameraHits {
-    #[inline(always)]
-    pub(super) fn p(&self, i: usize) -> Vec3 {
-        at(&self.camera.p, i)
-    }
-
-    #[inline(always)]
-    pub(super) fn ng(&self, i: usize) -> Vec3 {
-        at(&self.camera.ng, i)
-    }
-
-    #[inline(always)]
-    pub(super) fn ns(&self, i: usize) -> Vec3 {
-        at(&self.camera.ns, i)
-    }
-
-    #[inline(always)]
-    pub(super) fn err(&self, i: usize) -> Vec3 {
-        at(&self.camera.err, i)
-    }
 }
 
 /// The lanes' rays and candidate contributions, before visibility. Every shading pass writes
@@ -367,8 +339,8 @@ impl Direct<'_> {
         let s = &self.strategy;
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
         for i in 0..LANES {
-            let (p, ng, err) = (h.p(i), h.ng(i), h.err(i));
-            let frame = Frame::from_normal(h.ns(i));
+            let sp = h.camera.point(i);
+            let (p, frame) = (sp.p, Frame::from_normal(sp.ns));
             let wi = frame.to_local(-h.d.get(i));
             let diffuse = Diffuse {
                 reflectance: h.reflectance.get(i),
@@ -382,8 +354,8 @@ impl Direct<'_> {
             o.light.set(i, f * radiance * (w / p_light));
             o.light_ok[i] = drawn && f != Rgb::ZERO && radiance != Rgb::ZERO;
             let lp = lsp.p;
-            let so = offset_origin(p, ng, err, lp - p);
-            let target = offset_origin(lp, lsp.ng, lsp.err_scale, so - lp);
+            let so = sp.spawn_origin(lp - p);
+            let target = lsp.spawn_origin(so - lp);
             o.shadow
                 .set(i, &Scene::shadow_ray_to(so, target, h.skip[i]));
             // BSDF sample and `Scene::bsdf_ray`'s origin.
@@ -397,7 +369,7 @@ impl Direct<'_> {
             o.bsdf_weight.set(i, diffuse.reflectance);
             let d = frame.to_world(wo);
             o.bsdf
-                .set(i, &bsdf_ray(offset_origin(p, ng, err, d), d, h.skip[i]));
+                .set(i, &Scene::ray_from(sp.spawn_origin(d), d, h.skip[i]));
         }
     }
 
@@ -432,7 +404,10 @@ impl Direct<'_> {
                     pdf: sh.bsdf_pdf[i],
                     delta: false,
                 };
-                bsdf.set(i, self.bsdf_emission(h.p(i), ray.d, &hit, &bs, bsdf_w));
+                bsdf.set(
+                    i,
+                    self.bsdf_emission(h.camera.point(i).p, ray.d, &hit, &bs, bsdf_w),
+                );
             }
         }
         // `li`'s sum, in its order, for all lanes at once; only covered lanes are kept.
@@ -461,16 +436,6 @@ fn one_shape<'s>(shapes: &'s [LaneShape], camera: &PacketHits) -> Option<&'s Lan
         same |= ((camera.shape[i] == first) as u32) << i;
     }
     (same & camera.mask == camera.mask).then(|| &shapes[first as usize])
-}
-
-/// A lane's BSDF ray as the lane kernel traces it: from origin `o`, unbounded, skipping the
-/// hit triangle `skip` of the main structure.
-#[inline(always)]
-pub(super) fn bsdf_ray(o: Vec3, d: Vec3, skip: u32) -> Ray {
-    Ray {
-        skip,
-        ..Ray::new(o, d)
-    }
 }
 
 /// The lanes whose flag is set, as a mask.

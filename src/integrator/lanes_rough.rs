@@ -10,11 +10,11 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::direct::{heuristic, Direct};
-use super::lanes::{bsdf_ray, CameraHits, Shaded, V3x8};
+use super::lanes::{CameraHits, Shaded, V3x8};
 use super::lanes_light::{light_sample, LightDraws, SphereDraws};
 use crate::bsdf::fresnel::fresnel_conductor_channel;
 use crate::bsdf::RoughConductor;
-use crate::math::{offset_origin, Frame, Rgb};
+use crate::math::{Frame, Rgb};
 use crate::rng::LANES;
 use crate::sampling::microfacet::{
     beckmann_visible_y, slope_step, BeckmannVisible, Microfacet, MicrofacetDistribution,
@@ -80,14 +80,14 @@ impl Direct<'_> {
         let mut wi_local = V3x8::default();
         let mut lambda_i = [0.0f32; LANES];
         for i in 0..LANES {
-            let (p, ng, err) = (h.p(i), h.ng(i), h.err(i));
-            let (drawn, wl, pdf_area, radiance, lsp) = light_sample::<true>(p, ld, sd, u, i);
+            let sp = h.camera.point(i);
+            let (drawn, wl, pdf_area, radiance, lsp) = light_sample::<true>(sp.p, ld, sd, u, i);
             let lp = lsp.p;
-            let so = offset_origin(p, ng, err, lp - p);
-            let target = offset_origin(lp, lsp.ng, lsp.err_scale, so - lp);
+            let so = sp.spawn_origin(lp - sp.p);
+            let target = lsp.spawn_origin(so - lp);
             o.shadow
                 .set(i, &Scene::shadow_ray_to(so, target, h.skip[i]));
-            let frame = Frame::from_normal(h.ns(i));
+            let frame = Frame::from_normal(sp.ns);
             let wi = frame.to_local(-h.d.get(i));
             let rc = h.rough_conductor(i);
             // Smith's Lambda(wi), once for both samples' evaluations.
@@ -141,7 +141,7 @@ impl Direct<'_> {
             }
         }
         for i in 0..LANES {
-            let (p, ng, err) = (h.p(i), h.ng(i), h.err(i));
+            let sp = h.camera.point(i);
             let rc = h.rough_conductor(i);
             let wi = wi_local.get(i);
             let m = rc.mf.beckmann_visible_end(&vis.get(i));
@@ -154,9 +154,9 @@ impl Direct<'_> {
             o.bsdf_ok[i] = ok;
             o.bsdf_pdf[i] = pdf;
             o.bsdf_weight.set(i, weight);
-            let d = Frame::from_normal(h.ns(i)).to_world(wo);
+            let d = Frame::from_normal(sp.ns).to_world(wo);
             o.bsdf
-                .set(i, &bsdf_ray(offset_origin(p, ng, err, d), d, h.skip[i]));
+                .set(i, &Scene::ray_from(sp.spawn_origin(d), d, h.skip[i]));
         }
     }
 }

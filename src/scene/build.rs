@@ -396,9 +396,17 @@ impl Scene {
     /// A ray leaving `sp` in direction `d`.
     #[inline]
     pub fn spawn_ray(&self, sp: &SurfacePoint, d: glam::Vec3) -> Ray {
+        Scene::ray_from(sp.spawn_origin(d), d, self.accel.skip_id(sp))
+    }
+
+    /// The unbounded ray from origin `o` (already off its surface) along `d`, skipping
+    /// triangle `skip`: `spawn_ray` once its origin and skip id are known (the lane kernel
+    /// has both per lane).
+    #[inline(always)]
+    pub fn ray_from(o: glam::Vec3, d: glam::Vec3, skip: u32) -> Ray {
         Ray {
-            skip: self.accel.skip_id(sp),
-            ..Ray::new(sp.spawn_origin(d), d)
+            skip,
+            ..Ray::new(o, d)
         }
     }
 
