@@ -9,6 +9,7 @@ use crate::bsdf::{BsdfKind, RoughConductor};
 use crate::emitter::{AreaLight, Emitter, EmitterSelector, LightSampling};
 use crate::geometry::{lookup8, Mesh, ShapeKind, Sphere, NO_SKIP};
 use crate::rng::LANES;
+use crate::sampling::elementary::small_int_bits;
 use crate::sampling::microfacet::MicrofacetDistribution;
 use crate::sampling::AliasTable;
 use crate::scene::desc::StrategyKind;
@@ -99,16 +100,19 @@ impl LaneAlias {
     #[inline(always)]
     pub(super) fn draw(&self, u: &[f32; LANES]) -> [u32; LANES] {
         let (nf, last) = (self.n as f32, (self.n - 1) as f32);
-        let (mut x, mut bin) = ([0.0; LANES], [0u32; LANES]);
+        let (mut x, mut binf, mut bin) = ([0.0; LANES], [0.0f32; LANES], [0u32; LANES]);
         for k in 0..LANES {
             x[k] = u[k] * nf;
             // `bin_index(x, n)`: the clamp to n - 1, an integer, commutes with truncation.
-            bin[k] = x[k].max(0.0).min(last) as u32;
+            // The truncated float is the bin exactly (n <= 8), its integer the low bits of
+            // `small_int_bits` (`as u32` would be a scalar conversion per lane).
+            binf[k] = x[k].max(0.0).min(last).trunc();
+            bin[k] = small_int_bits(binf[k]) & 0xff;
         }
         let (keep, alias) = (lookup8(&self.keep, &bin), lookup8(&self.alias, &bin));
         let mut out = [0u32; LANES];
         for k in 0..LANES {
-            let frac = x[k] - bin[k] as f32;
+            let frac = x[k] - binf[k];
             out[k] = if frac < keep[k] {
                 bin[k]
             } else {

@@ -50,7 +50,7 @@ pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
 fn sin_cos_turns(u: f32) -> (f32, f32) {
     let q = (4.0 * u).round_ties_even();
     let (s, c) = sin_cos_quarter(2.0 * PI * (u - 0.25 * q));
-    let quarter = q as i32 & 3;
+    let quarter = crate::sampling::elementary::small_int_bits(q) & 3;
     let (s, c) = if quarter & 1 == 1 { (c, -s) } else { (s, c) };
     if quarter & 2 == 2 {
         (-s, -c)
