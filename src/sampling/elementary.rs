@@ -5,7 +5,8 @@
 //! only additions, (fused) multiplications, one division at most, bit operations and selects,
 //! so they inline and vectorise, eight lanes to a 256-bit register. exp and ln are Cephes'
 //! expf and logf, accurate to about an ulp (the unit tests bound them against std's f64
-//! functions); atan is Cephes' atanf.
+//! functions); atan is Cephes' atanf. `small_int_bits`, exp's float-to-integer step, also
+//! serves the other lane loops that need one (`warps`, the lane kernel's alias draw).
 
 // Cephes' split of ln 2: k * LN2_HI is exact for |k| < 2^9.
 const LN2_HI: f32 = 0.693_359_4;

@@ -1,6 +1,7 @@
 //! Warps from the unit square to the study's domains, each with the density it produces.
 //! Densities are with respect to area on the target domain (solid angle for directions).
 
+use super::elementary::small_int_bits;
 use crate::math::{INV_PI, PI};
 use glam::{Vec2, Vec3};
 
@@ -50,7 +51,7 @@ pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
 fn sin_cos_turns(u: f32) -> (f32, f32) {
     let q = (4.0 * u).round_ties_even();
     let (s, c) = sin_cos_quarter(2.0 * PI * (u - 0.25 * q));
-    let quarter = crate::sampling::elementary::small_int_bits(q) & 3;
+    let quarter = small_int_bits(q) & 3;
     let (s, c) = if quarter & 1 == 1 { (c, -s) } else { (s, c) };
     if quarter & 2 == 2 {
         (-s, -c)
