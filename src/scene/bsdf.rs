@@ -37,7 +37,7 @@ const IORS: &[(&str, f32)] = &[
 /// Complex IOR (eta, k) of common metals, projected to linear RGB from Mitsuba's measured
 /// spectra (values as tabulated by the Tungsten renderer). Mitsuba 3's own RGB projection may
 /// differ in the third digit.
-const METALS: &[(&str, [f32; 3], [f32; 3])] = &[
+pub(crate) const METALS: &[(&str, [f32; 3], [f32; 3])] = &[
     (
         "Ag",
         [0.15526, 0.11672, 0.13838],
@@ -161,6 +161,14 @@ fn conductor_params(p: &Plugin) -> Result<(Rgb, Rgb, Rgb), SceneError> {
         }
         _ => return Err(p.err("give both 'eta' and 'k' (or a material name)")),
     };
+    for (key, v) in [("eta", eta), ("k", k)] {
+        let max = crate::bsdf::fresnel::MAX_INDEX;
+        if v.min_element() < 0.0 || v.max_element() > max {
+            return Err(p.err(format!(
+                "conductor {key} must lie in [0, {max:e}] in every channel, found {v}"
+            )));
+        }
+    }
     let spec = p.color("specular_reflectance")?.unwrap_or(Vec3::ONE);
     Ok((eta, k, spec))
 }

@@ -344,6 +344,16 @@ fn bsdf_parameters_and_defaults() {
         r#"<bsdf type="conductor" id="c"><string name="material" value="Unobtainium"/></bsdf>"#,
     );
     assert!(e.contains("not supported yet"), "{e}");
+    for (eta, k) in [("-0.2", "3"), ("0.2", "1e7"), ("0.2", "1, 2, -3")] {
+        let e = m3_err(&format!(
+            r#"<bsdf type="roughconductor" id="c"><rgb name="eta" value="{eta}"/><rgb name="k" value="{k}"/></bsdf>"#
+        ));
+        assert!(
+            e.contains("test.xml:2: <bsdf type=\"roughconductor\" id=\"c\">: conductor ")
+                && e.contains("must lie in [0, 1e6] in every channel"),
+            "{e}"
+        );
+    }
     let e = m3_err(r#"<bsdf type="plastic" id="p"/>"#);
     assert!(
         e.contains(
