@@ -8,14 +8,18 @@
 use crate::geometry::{Ray, RayPacket, NO_SKIP};
 use crate::rng::{Rng, RngLanes, LANES};
 use crate::scene::desc::{CameraDesc, FilmDesc, FilterDesc, FovAxis};
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 
 #[derive(Clone, Debug)]
 pub struct Camera {
-    to_world: Mat4,
     origin: Vec3,
-    /// tan of the half field of view along x and y.
-    tan_half: Vec2,
+    /// The world direction (camera depth 1, unnormalised) through film point (x, y), in
+    /// pixels from the top left corner, is `corner + x * step_x + y * step_y`: two
+    /// multiply-adds per component, where dividing by the film size took two divisions in
+    /// each camera ray's chain of dependent operations before traversal.
+    corner: Vec3,
+    step_x: Vec3,
+    step_y: Vec3,
     pub width: u32,
     pub height: u32,
     near: f32,
@@ -42,10 +46,14 @@ impl Camera {
                 Vec2::new(t * w / diag, t * h / diag)
             }
         };
+        let m = desc.to_world;
+        // Camera +x is the image's left (Mitsuba/Nori convention), +y is up.
+        let [ax, ay, az] = [m.x_axis, m.y_axis, m.z_axis].map(|a| a.truncate());
         Camera {
-            to_world: desc.to_world,
             origin: desc.to_world.transform_point3(Vec3::ZERO),
-            tan_half,
+            corner: az + ax * tan_half.x + ay * tan_half.y,
+            step_x: ax * (-2.0 * tan_half.x / w),
+            step_y: ay * (-2.0 * tan_half.y / h),
             width: film.width,
             height: film.height,
             near: desc.near_clip,
@@ -79,31 +87,30 @@ impl Camera {
     #[inline]
     pub fn generate_ray(&self, px: u32, py: u32, rng: &mut Rng) -> Ray {
         let off = self.filter_offset(rng);
-        let fx = (px as f32 + 0.5 + off.x) / self.width as f32;
-        let fy = (py as f32 + 0.5 + off.y) / self.height as f32;
-        // Camera +x is the image's left (Mitsuba/Nori convention), +y is up.
-        let d_cam = Vec3::new(
-            (1.0 - 2.0 * fx) * self.tan_half.x,
-            (1.0 - 2.0 * fy) * self.tan_half.y,
-            1.0,
-        );
-        let d = self.to_world.transform_vector3(d_cam);
+        let (fx, fy) = (px as f32 + 0.5 + off.x, py as f32 + 0.5 + off.y);
+        let d = self.direction(fx, fy);
         let len = d.length();
-        // The clip planes sit at camera-space depths near and far; d_cam has depth 1, so
-        // they are near*|d| and far*|d| along the unit world ray.
+        // The clip planes sit at camera-space depths near and far; d has depth 1, so they
+        // are near*|d| and far*|d| along the unit world ray.
         Ray {
             o: self.origin,
-            d: crate::math::div3(d, len),
+            d: d * len.recip(),
             tmin: self.near * len,
             tmax: self.far * len,
             skip: NO_SKIP,
         }
     }
 
+    /// The unnormalised world direction through film point (fx, fy), in pixels.
+    #[inline(always)]
+    fn direction(&self, fx: f32, fy: f32) -> Vec3 {
+        self.corner + self.step_x * fx + self.step_y * fy
+    }
+
     /// `generate_ray` for `LANES` samples of pixel (px, py), lane i drawing from lane i of
-    /// `rng`: the same IEEE operations in the same order (glam's `transform_vector3` is
-    /// x*dx + y*dy + z*1, `length` is (x*x + y*y) + z*z), so every ray is bitwise the one
-    /// `generate_ray` gives, computed eight at a time.
+    /// `rng`: the same IEEE operations in the same order (glam's `length` is
+    /// (x*x + y*y) + z*z), so every ray is bitwise the one `generate_ray` gives, computed
+    /// eight at a time.
     #[inline]
     pub fn generate_rays(&self, px: u32, py: u32, rng: &mut RngLanes) -> RayPacket {
         let (ox, oy) = match self.filter {
@@ -122,27 +129,23 @@ impl Camera {
                 (ox, oy)
             }
         };
-        let (w, h) = (self.width as f32, self.height as f32);
         let (cx, cy) = (px as f32 + 0.5, py as f32 + 0.5);
-        let [ax, ay, az] = [
-            self.to_world.x_axis.truncate(),
-            self.to_world.y_axis.truncate(),
-            self.to_world.z_axis.truncate(),
-        ];
+        let [corner, step_x, step_y] =
+            [self.corner, self.step_x, self.step_y].map(|v| v.to_array());
         let mut d = [[0.0f32; LANES]; 3];
         let mut len = [0.0f32; LANES];
         for i in 0..LANES {
-            let dx = (1.0 - 2.0 * ((cx + ox[i]) / w)) * self.tan_half.x;
-            let dy = (1.0 - 2.0 * ((cy + oy[i]) / h)) * self.tan_half.y;
-            for c in 0..3 {
-                d[c][i] = ax[c] * dx + ay[c] * dy + az[c];
+            let (fx, fy) = (cx + ox[i], cy + oy[i]);
+            for (c, d) in d.iter_mut().enumerate() {
+                d[i] = corner[c] + step_x[c] * fx + step_y[c] * fy;
             }
             len[i] = (d[0][i] * d[0][i] + d[1][i] * d[1][i] + d[2][i] * d[2][i]).sqrt();
         }
         let mut rays = RayPacket::splat(&Ray::new(self.origin, Vec3::Z));
         for i in 0..LANES {
+            let inv = len[i].recip();
             for (unit, d) in rays.d.iter_mut().zip(&d) {
-                unit[i] = d[i] / len[i];
+                unit[i] = d[i] * inv;
             }
             (rays.tmin[i], rays.tmax[i]) = (self.near * len[i], self.far * len[i]);
         }
@@ -170,25 +173,34 @@ mod tests {
         Camera::new(&desc, &film)
     }
 
+    /// The film's corners look along (+-tan_x, +-tan_y, 1) in camera space, the tangents of
+    /// the half field of view that each axis rule gives.
     #[test]
     fn fov_axes() {
-        let c = camera(FovAxis::X, 200, 100);
-        assert!((c.tan_half - Vec2::new(1.0, 0.5)).length() < 1e-6);
-        let c = camera(FovAxis::Y, 200, 100);
-        assert!((c.tan_half - Vec2::new(2.0, 1.0)).length() < 1e-6);
-        let c = camera(FovAxis::Smaller, 200, 100);
-        assert!((c.tan_half - Vec2::new(2.0, 1.0)).length() < 1e-6);
-        let c = camera(FovAxis::Larger, 200, 100);
-        assert!((c.tan_half - Vec2::new(1.0, 0.5)).length() < 1e-6);
-        let c = camera(FovAxis::Diagonal, 300, 400);
-        assert!((c.tan_half - Vec2::new(0.6, 0.8)).length() < 1e-6);
+        let cases = [
+            (FovAxis::X, 200, 100, (1.0, 0.5)),
+            (FovAxis::Y, 200, 100, (2.0, 1.0)),
+            (FovAxis::Smaller, 200, 100, (2.0, 1.0)),
+            (FovAxis::Larger, 200, 100, (1.0, 0.5)),
+            (FovAxis::Diagonal, 300, 400, (0.6, 0.8)),
+        ];
+        for (axis, w, h, (tx, ty)) in cases {
+            let c = camera(axis, w, h);
+            for (fx, fy) in [(0.0, 0.0), (w as f32, h as f32), (0.0, h as f32)] {
+                let d = c.direction(fx, fy);
+                let want = Vec3::new(tx, ty, 1.0);
+                assert!((d.abs() - want).length() < 1e-6, "{axis:?} {d} vs {want}");
+            }
+            let mid = c.direction(w as f32 / 2.0, h as f32 / 2.0);
+            assert!((mid - Vec3::Z).length() < 1e-6, "{axis:?} centre {mid}");
+        }
     }
 
     #[test]
     fn centre_ray_looks_forward_and_left_pixel_looks_to_plus_x() {
         let c = Camera::new(
             &CameraDesc {
-                to_world: Mat4::IDENTITY,
+                to_world: glam::Mat4::IDENTITY,
                 fov_degrees: 90.0,
                 fov_axis: FovAxis::X,
                 near_clip: 0.5,
