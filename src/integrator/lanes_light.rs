@@ -27,18 +27,19 @@ pub(super) struct SphereDraws {
 /// The light triangle of each lane and its data, gathered with scalar table lookups (for a
 /// sphere light, only `shape`, `radiance`, `area` and `pmf`).
 #[derive(Default)]
+#[repr(C)]
 pub(super) struct LightDraws {
     v: [V3x8; 3],
     ng: V3x8,
     err: V3x8,
     /// Vertex normals, where the mesh has them (`has_normals`).
     n: [V3x8; 3],
-    has_normals: [bool; LANES],
     shape: [u32; LANES],
     tri: [u32; LANES],
     radiance: V3x8,
     area: [f32; LANES],
     pub(super) pmf: [f32; LANES],
+    has_normals: [bool; LANES],
 }
 
 impl LightDraws {

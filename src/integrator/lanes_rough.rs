@@ -10,7 +10,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::direct::{heuristic, Direct};
-use super::lanes::{CameraHits, Shaded, V3x8};
+use super::lanes::{CameraHits, Shaded, V3x8, SAMPLE_COUNTS};
 use super::lanes_light::{light_sample, LightDraws, SphereDraws};
 use crate::bsdf::fresnel::fresnel_conductor_channel;
 use crate::bsdf::RoughConductor;
@@ -76,7 +76,7 @@ impl Direct<'_> {
         o: &mut Shaded,
     ) {
         let s = &self.strategy;
-        let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
+        let (ne, nb) = SAMPLE_COUNTS;
         let mut wi_local = V3x8::default();
         let mut lambda_i = [0.0f32; LANES];
         for i in 0..LANES {
@@ -164,6 +164,7 @@ impl Direct<'_> {
 /// Eight `BeckmannVisible`s, one array per field: the loops over them then run in vector
 /// lanes, which they did not over an array of the structures.
 #[derive(Default)]
+#[repr(C, align(32))] // see `V3x8`
 struct VisibleX8 {
     cos_phi: [f32; LANES],
     sin_phi: [f32; LANES],
