@@ -40,9 +40,12 @@ pub struct RayMix {
 
 #[derive(Clone, Copy)]
 pub struct Packets {
-    /// Rays and active-lane masks.
-    pub camera: (RayPacket, u32),
-    pub shadow: (RayPacket, u32),
+    /// Rays, and their active-lane masks (apart: a (packet, mask) pair pads to a whole
+    /// packet alignment).
+    pub camera: RayPacket,
+    pub shadow: RayPacket,
+    pub camera_mask: u32,
+    pub shadow_mask: u32,
     /// Per lane, its BSDF ray's index in `RayMix::bsdf`, or `NONE`.
     pub bsdf: [u32; LANES],
 }
@@ -53,16 +56,20 @@ pub const NONE: u32 = u32::MAX;
 #[cfg(test)]
 impl RayMix {
     pub fn camera_rays(&self) -> impl Iterator<Item = Ray> + '_ {
-        self.packets.iter().flat_map(|p| lanes(&p.camera))
+        self.packets
+            .iter()
+            .flat_map(|p| lanes(&p.camera, p.camera_mask))
     }
 
     pub fn shadow_rays(&self) -> impl Iterator<Item = Ray> + '_ {
-        self.packets.iter().flat_map(|p| lanes(&p.shadow))
+        self.packets
+            .iter()
+            .flat_map(|p| lanes(&p.shadow, p.shadow_mask))
     }
 }
 
 /// The active rays of a packet.
-fn lanes((rays, mask): &(RayPacket, u32)) -> impl Iterator<Item = Ray> + '_ {
+fn lanes(rays: &RayPacket, mask: u32) -> impl Iterator<Item = Ray> + '_ {
     (0..LANES)
         .filter(move |i| mask >> i & 1 != 0)
         .map(|i| rays.ray(i))
@@ -85,16 +92,18 @@ pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
                 let lane = s as usize % LANES;
                 if lane == 0 {
                     mix.packets.push(Packets {
-                        camera: (empty, 0),
-                        shadow: (empty, 0),
+                        camera: empty,
+                        shadow: empty,
+                        camera_mask: 0,
+                        shadow_mask: 0,
                         bsdf: [NONE; LANES],
                     });
                 }
                 let p = mix.packets.last_mut().expect("pushed above");
                 let mut rng = Rng::for_sample(MIX_SEED, (y * cam.width + x) as u64, s as u64);
                 let ray = cam.generate_ray(x, y, &mut rng);
-                p.camera.0.set(lane, &ray);
-                p.camera.1 |= 1 << lane;
+                p.camera.set(lane, &ray);
+                p.camera_mask |= 1 << lane;
                 mix.n_camera += 1;
                 let Some(hit) = scene.intersect(&ray) else {
                     continue;
@@ -110,8 +119,8 @@ pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
                 }) {
                     let (f, _) = mat.eval_pdf(wi, frame.to_local(ls.wi));
                     if f != Rgb::ZERO && ls.li != Rgb::ZERO {
-                        p.shadow.0.set(lane, &scene.shadow_ray(&sp, &ls));
-                        p.shadow.1 |= 1 << lane;
+                        p.shadow.set(lane, &scene.shadow_ray(&sp, &ls));
+                        p.shadow_mask |= 1 << lane;
                         mix.n_shadow += 1;
                     }
                 }
@@ -194,7 +203,7 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
             let w = warm.load(mix, chunk);
             let t = Instant::now();
             for p in &w.packets {
-                sink += packet_prims(scene, &p.camera, &mut hits);
+                sink += packet_prims(scene, &p.camera, p.camera_mask, &mut hits);
             }
             let t1 = Instant::now();
             for (r, _) in &w.bsdf {
@@ -206,7 +215,7 @@ pub fn measure(scene: &Scene, mix: &RayMix, repeat: u32, mut render: impl FnMut(
             }
             let t3 = Instant::now();
             for p in &w.packets {
-                sink += scene.accel.occluded8(&p.shadow.0, p.shadow.1) as usize;
+                sink += scene.accel.occluded8(&p.shadow, p.shadow_mask) as usize;
             }
             let t4 = Instant::now();
             for (k, (a, b)) in [(t, t1), (t1, t2), (t2, t3), (t3, t4)]
@@ -255,8 +264,8 @@ fn prim(h: Option<Hit>) -> usize {
 
 /// The camera packet's hits, traced as the renderer traces them: into hits reused from
 /// packet to packet (`LaneScratch`).
-fn packet_prims(scene: &Scene, (rays, active): &(RayPacket, u32), h: &mut PacketHits) -> usize {
-    scene.intersect8_into(rays, *active, h);
+fn packet_prims(scene: &Scene, rays: &RayPacket, active: u32, h: &mut PacketHits) -> usize {
+    scene.intersect8_into(rays, active, h);
     (0..LANES).map(|i| prim(h.get(i))).sum()
 }
 
@@ -337,8 +346,8 @@ fn trace_in_order<'a>(
         let w = warm.load(mix, chunk);
         let t = Instant::now();
         for (p, b) in w.packets.iter().zip(&w.bsdf_packets) {
-            sink += packet_prims(scene, &p.camera, &mut hits);
-            sink += scene.accel.occluded8(&p.shadow.0, p.shadow.1) as usize;
+            sink += packet_prims(scene, &p.camera, p.camera_mask, &mut hits);
+            sink += scene.accel.occluded8(&p.shadow, p.shadow_mask) as usize;
             sink += bsdf_queries(scene, b);
         }
         seconds += t.elapsed().as_secs_f64();
@@ -519,13 +528,20 @@ pub fn measure_obvhs(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
         for chunk in mix.packets.chunks(CHUNK) {
             let w = warm.load(mix, chunk);
             let t = Instant::now();
-            let camera = w.packets.iter().flat_map(|p| lanes(&p.camera));
+            let camera = w
+                .packets
+                .iter()
+                .flat_map(|p| lanes(&p.camera, p.camera_mask));
             for r in camera.chain(w.bsdf.iter().map(|b| b.0)) {
                 let mut hit = obvhs::ray::RayHit::none();
                 sink += bvh.ray_traverse(ray(&r), &mut hit, prim) as usize;
             }
             let t1 = Instant::now();
-            for r in w.packets.iter().flat_map(|p| lanes(&p.shadow)) {
+            for r in w
+                .packets
+                .iter()
+                .flat_map(|p| lanes(&p.shadow, p.shadow_mask))
+            {
                 sink += !bvh.ray_traverse_miss(ray(&r), prim) as usize;
             }
             closest += (t1 - t).as_secs_f64();
@@ -644,14 +660,14 @@ mod tests {
         for (k, p) in mix.packets.iter().enumerate() {
             let (pixel, s0) = (k / 2, 8 * (k % 2) as u32);
             let n = if k % 2 == 0 { 8 } else { 4 };
-            assert_eq!(p.camera.1, (1 << n) - 1);
+            assert_eq!(p.camera_mask, (1 << n) - 1);
             for lane in 0..n {
                 let (x, y) = (pixel as u32 % cam.width, pixel as u32 / cam.width);
                 let mut rng = Rng::for_sample(7, pixel as u64, (s0 + lane as u32) as u64);
-                assert_eq!(p.camera.0.d(lane), cam.generate_ray(x, y, &mut rng).d);
-                let hit = scene.intersect(&p.camera.0.ray(lane)).is_some();
+                assert_eq!(p.camera.d(lane), cam.generate_ray(x, y, &mut rng).d);
+                let hit = scene.intersect(&p.camera.ray(lane)).is_some();
                 assert_eq!(
-                    p.shadow.1 >> lane & 1 != 0,
+                    p.shadow_mask >> lane & 1 != 0,
                     hit,
                     "the light is above the floor"
                 );
@@ -662,15 +678,12 @@ mod tests {
                 );
                 if hit {
                     let b = &mix.bsdf[p.bsdf[lane] as usize].0;
-                    assert!(
-                        p.shadow.0.ray(lane).o.distance(b.o) < 1e-3,
-                        "same hit point"
-                    );
+                    assert!(p.shadow.ray(lane).o.distance(b.o) < 1e-3, "same hit point");
                 }
                 shadows += hit as usize;
                 bsdfs += hit as usize;
             }
-            assert_eq!(p.shadow.1 >> n, 0);
+            assert_eq!(p.shadow_mask >> n, 0);
         }
         assert_eq!((shadows, bsdfs), (mix.n_shadow, mix.bsdf.len()));
         assert!(shadows > 0);
@@ -690,9 +703,12 @@ mod tests {
             let w = warm.load(&mix, chunk);
             assert_eq!(w.bsdf_packets.len(), chunk.len());
             for ((p, q), lanes) in chunk.iter().zip(&w.packets).zip(&w.bsdf_packets) {
-                assert_eq!((p.camera.1, p.shadow.1), (q.camera.1, q.shadow.1));
-                assert_eq!(p.camera.0.d, q.camera.0.d);
-                assert_eq!(p.shadow.0.o, q.shadow.0.o);
+                assert_eq!(
+                    (p.camera_mask, p.shadow_mask),
+                    (q.camera_mask, q.shadow_mask)
+                );
+                assert_eq!(p.camera.d, q.camera.d);
+                assert_eq!(p.shadow.o, q.shadow.o);
                 for (i, (&b, &c)) in p.bsdf.iter().zip(&q.bsdf).enumerate() {
                     assert_eq!(b == NONE, c == NONE);
                     assert_eq!(
