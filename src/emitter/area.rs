@@ -77,7 +77,7 @@ pub(crate) fn sample_at(
 /// `AreaLight::sample` and the lane kernel, so both make the same point).
 #[inline]
 pub(crate) fn sphere_area_point(s: &Sphere, u: Vec2, shape: u32) -> SurfacePoint {
-    s.surface_point(s.center + square_to_uniform_sphere(u) * s.radius, shape)
+    s.surface_point_along(square_to_uniform_sphere(u), shape)
 }
 
 /// Whether a sphere is sampled by its visible cone from `ref_p`: only from outside, and only
