@@ -42,8 +42,8 @@ impl RoughConductor {
     /// |e| < 1e-5 of unit inputs (f32 normalisation leaves |e| ~ 1e-7; not asserted: the lane
     /// kernel's uncovered lanes pass garbage, whose results it drops). The sum's length is
     /// taken in f32 and applied in f64: a common scale does not turn the vector, so only the
-    /// final rounding to f32 does. Eight lanes of f64 square roots and divisions, five per
-    /// sample, cost the Veach scene about 1 % of its render time.
+    /// final rounding to f32 does (f64 roots and divisions: see `fresnel_conductor_channel`
+    /// for their cost).
     #[inline]
     pub(crate) fn half(wi: Vec3, wo: Vec3) -> Vec3 {
         let (wi, wo) = (wi.as_dvec3(), wo.as_dvec3());

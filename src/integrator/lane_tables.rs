@@ -278,7 +278,7 @@ pub(super) fn lane_setup<'a>(
 /// lanes cover.
 fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>> {
     let covered = s.kind == StrategyKind::Mis
-        && (s.emitter_samples as f32, s.bsdf_samples as f32) == super::lanes::SAMPLE_COUNTS
+        && (s.emitter_samples, s.bsdf_samples) == super::lanes::SAMPLE_COUNTS
         && s.light_sampling == LightSampling::Area
         && !scene.emitters.is_empty();
     if !covered {

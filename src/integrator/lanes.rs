@@ -33,11 +33,14 @@ use glam::{Vec2, Vec3};
 // A pixel's eight samples trace their camera and shadow rays as one packet.
 const _: () = assert!(LANES == crate::geometry::packet::PACKET);
 
-/// `li`'s light and BSDF sample counts, as f32, under the only strategies the lanes cover
-/// (`lane_tables::lane_lights`): as constants, `li`'s divisions by them (six per batch)
-/// and multiplications compile to nothing, which dividing by a 1 read from the strategy
-/// did not. x / 1 and 1 * x are x exactly, so every sample is still bitwise `li`'s.
-pub(super) const SAMPLE_COUNTS: (f32, f32) = (1.0, 1.0);
+/// The light and BSDF sample counts of the only strategies the lanes cover
+/// (`lane_tables::lane_lights`). As constants, `li`'s divisions by them (six per batch) and
+/// multiplications compile to nothing, which dividing by a 1 read from the strategy did not.
+/// x / 1 and 1 * x are x exactly, so every sample is still bitwise `li`'s.
+pub(super) const SAMPLE_COUNTS: (u32, u32) = (1, 1);
+
+/// `SAMPLE_COUNTS` as the f32 factors `li` uses.
+pub(super) const SAMPLE_COUNTS_F32: (f32, f32) = (SAMPLE_COUNTS.0 as f32, SAMPLE_COUNTS.1 as f32);
 
 /// Eight 3-vectors, one array per component. The kernel's lane arrays are 32-byte aligned
 /// and their structures `repr(C)` with flags last, for the reason `PacketHits` gives.
@@ -348,7 +351,7 @@ impl Direct<'_> {
         o: &mut Shaded,
     ) {
         let s = &self.strategy;
-        let (ne, nb) = SAMPLE_COUNTS;
+        let (ne, nb) = SAMPLE_COUNTS_F32;
         for i in 0..LANES {
             let sp = h.camera.point(i);
             let (p, frame) = (sp.p, Frame::from_normal(sp.ns));
@@ -395,7 +398,7 @@ impl Direct<'_> {
     ) {
         let scene = self.scene;
         let s = &self.strategy;
-        let (ne, nb) = SAMPLE_COUNTS;
+        let (ne, nb) = SAMPLE_COUNTS_F32;
         let bsdf_w = |pb, pl| heuristic(s.heuristic, nb * pb, ne * pl);
         // Every lane's ray is computed; only those of covered lanes with a light sample
         // are traced.

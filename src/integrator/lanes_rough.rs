@@ -10,7 +10,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::direct::{heuristic, Direct};
-use super::lanes::{CameraHits, Shaded, V3x8, SAMPLE_COUNTS};
+use super::lanes::{CameraHits, Shaded, V3x8, SAMPLE_COUNTS_F32};
 use super::lanes_light::{light_sample, LightDraws, SphereDraws};
 use crate::bsdf::fresnel::fresnel_conductor_channel;
 use crate::bsdf::RoughConductor;
@@ -76,7 +76,7 @@ impl Direct<'_> {
         o: &mut Shaded,
     ) {
         let s = &self.strategy;
-        let (ne, nb) = SAMPLE_COUNTS;
+        let (ne, nb) = SAMPLE_COUNTS_F32;
         let mut wi_local = V3x8::default();
         let mut lambda_i = [0.0f32; LANES];
         for i in 0..LANES {
