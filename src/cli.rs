@@ -50,7 +50,7 @@ pub struct SweepArgs {
     #[arg(long, default_value = "reports")]
     pub out: PathBuf,
     /// Worker threads (default: all cores). Images do not depend on it; timings do.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::render::parse_threads)]
     pub threads: Option<usize>,
     /// Render the references again even if the cache has them (after upgrading a
     /// dependency; changes to the renderer's own source are detected).
@@ -94,7 +94,13 @@ fn run_files(files: &[PathBuf], a: &SweepArgs) -> Result<(), String> {
     for f in files {
         // One failing experiment should not cost the others their results.
         if let Err(e) = run_and_report(f, a.quick, &opts) {
-            eprintln!("error: {}: {e}", f.display());
+            // Errors about the file itself name it already.
+            let shown = f.display().to_string();
+            if e.starts_with(&shown) {
+                eprintln!("error: {e}");
+            } else {
+                eprintln!("error: {shown}: {e}");
+            }
             failed.push(f.display().to_string());
         }
     }
@@ -185,7 +191,10 @@ pub struct StrategyArgs {
 }
 
 impl StrategyArgs {
-    pub fn apply(&self, mut s: Strategy) -> Strategy {
+    /// `s` with these choices applied. Zero sample counts keep Mitsuba's meaning (see
+    /// [`StrategyKind::with_sample_counts`]); a choice that leaves nothing to sample is an
+    /// error.
+    pub fn apply(&self, mut s: Strategy) -> Result<Strategy, String> {
         if let Some(k) = self.strategy {
             s.kind = match k {
                 StrategyArg::Bsdf => StrategyKind::Bsdf,
@@ -213,12 +222,15 @@ impl StrategyArgs {
             };
         }
         if let Some(n) = self.emitter_samples {
-            s.emitter_samples = n.max(1);
+            s.emitter_samples = n;
         }
         if let Some(n) = self.bsdf_samples {
-            s.bsdf_samples = n.max(1);
+            s.bsdf_samples = n;
         }
-        s
+        s.kind = s
+            .kind
+            .with_sample_counts(s.emitter_samples, s.bsdf_samples)?;
+        Ok(s)
     }
 }
 
@@ -227,13 +239,13 @@ pub struct RenderArgs {
     /// Scene file (XML).
     pub scene: PathBuf,
     /// Samples per pixel (default: the scene's sampler).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
     /// Seed (default: the scene's sampler seed).
     #[arg(long)]
     pub seed: Option<u64>,
     /// Worker threads (default: all cores). The image does not depend on it.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::render::parse_threads)]
     pub threads: Option<usize>,
     /// Output EXR (default: <scene name>.exr in the current directory); a PNG preview is
     /// written beside it.
@@ -262,10 +274,13 @@ fn parse_define(s: &str) -> Result<(String, String), String> {
     Ok((k.to_string(), v.to_string()))
 }
 
-/// Loads and builds a scene, printing its warnings to stderr.
+/// Loads and builds a scene, printing its warnings to stderr. A film too large for this
+/// machine's memory is refused here, before any render starts.
 pub fn open_scene(path: &Path, defines: &[(String, String)]) -> Result<Scene, String> {
     let desc = load_scene(path, defines).map_err(|e| e.to_string())?;
     let scene = Scene::build(desc).map_err(|e| e.to_string())?;
+    crate::render::check_film_memory(scene.camera.width, scene.camera.height)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
@@ -287,17 +302,10 @@ struct RenderStats {
     mean_rgb: [f64; 3],
 }
 
-fn cmd_render(a: &RenderArgs) -> Result<(), String> {
-    let scene = open_scene(&a.scene, &a.define)?;
-    let strategy = a
-        .strategy
-        .apply(Strategy::from_desc(&scene.desc.integrator));
-    let settings = RenderSettings {
-        spp: a.spp.unwrap_or(scene.desc.sampler.sample_count).max(1),
-        seed: a.seed.unwrap_or(scene.desc.sampler.seed),
-        threads: a.threads,
-        progress: std::io::stderr().is_terminal(),
-    };
+/// The files `render` writes, checked before the scene is even loaded: each can be written,
+/// and no two are the same file (the PNG preview sits beside the EXR, so `--out x.png` would
+/// have the preview overwrite the image).
+fn render_outputs(a: &RenderArgs) -> Result<PathBuf, String> {
     let out = a.out.clone().unwrap_or_else(|| {
         let stem = a
             .scene
@@ -307,6 +315,44 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
             .to_string();
         PathBuf::from(format!("{stem}.exr"))
     });
+    let is_exr = out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !is_exr {
+        return Err(format!(
+            "--out {}: expected a file name ending in .exr (the PNG preview is written beside \
+             it, with .png)",
+            out.display()
+        ));
+    }
+    let png = out.with_extension("png");
+    let mut outputs: Vec<(&str, &Path)> = vec![("--out", &out), ("the PNG preview", &png)];
+    if let Some(v) = &a.variance {
+        outputs.push(("--variance", v));
+    }
+    if let Some(s) = &a.stats {
+        outputs.push(("--stats", s));
+    }
+    crate::output::check_distinct(&outputs)?;
+    for (_, p) in &outputs {
+        crate::output::check_writable(p)?;
+    }
+    Ok(out)
+}
+
+fn cmd_render(a: &RenderArgs) -> Result<(), String> {
+    let out = render_outputs(a)?;
+    let scene = open_scene(&a.scene, &a.define)?;
+    let strategy = a
+        .strategy
+        .apply(Strategy::from_desc(&scene.desc.integrator))?;
+    let settings = RenderSettings {
+        spp: a.spp.unwrap_or(scene.desc.sampler.sample_count),
+        seed: a.seed.unwrap_or(scene.desc.sampler.seed),
+        first_sample: 0,
+        threads: a.threads,
+        progress: std::io::stderr().is_terminal(),
+    };
     let result = render(&scene, strategy, &settings);
     film::write_exr(&out, &result.mean)?;
     film::write_png(&out.with_extension("png"), &result.mean)?;
@@ -328,7 +374,7 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
     };
     if let Some(p) = &a.stats {
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
-        film::write_atomic(p, |tmp| {
+        crate::output::write_atomic(p, |tmp| {
             std::fs::write(tmp, json).map_err(|e| format!("{}: {e}", p.display()))
         })?;
     }

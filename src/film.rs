@@ -1,7 +1,7 @@
 //! Images in f64 linear RGB, and their files: EXR (linear) and PNG (sRGB preview), always
 //! written to a temporary file first and renamed, so a failed write never replaces a good file.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
@@ -21,13 +21,12 @@ impl Image {
 
     #[inline]
     pub fn get(&self, x: u32, y: u32) -> [f64; 3] {
-        self.data[(y * self.width + x) as usize]
+        self.data[y as usize * self.width as usize + x as usize]
     }
 
     #[inline]
     pub fn set(&mut self, x: u32, y: u32, v: [f64; 3]) {
-        let w = self.width;
-        self.data[(y * w + x) as usize] = v;
+        self.data[y as usize * self.width as usize + x as usize] = v;
     }
 
     /// Mean over all pixels, per channel.
@@ -43,35 +42,7 @@ impl Image {
     }
 }
 
-/// A sibling path for the temporary file, in the same directory so rename is atomic.
-fn temp_path(path: &Path) -> PathBuf {
-    let mut name = path
-        .file_name()
-        .map(|n| n.to_os_string())
-        .unwrap_or_default();
-    name.push(format!(".tmp{}", std::process::id()));
-    path.with_file_name(name)
-}
-
-/// Writes through `write` into a temporary file, then renames it over `path`.
-pub fn write_atomic(
-    path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
-) -> Result<(), String> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("{}: cannot create directory: {e}", dir.display()))?;
-    }
-    let tmp = temp_path(path);
-    let result = write(&tmp).and_then(|_| {
-        std::fs::rename(&tmp, path)
-            .map_err(|e| format!("{}: cannot rename into place: {e}", path.display()))
-    });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
+use crate::output::write_atomic;
 
 /// Writes `img` as an RGB f32 EXR (RLE, 64x64 tiles: exr's default encoding) with its tiles
 /// in increasing order. exr's default order, `Unspecified`, let its parallel compressor write
@@ -198,21 +169,5 @@ mod tests {
             exr::prelude::LineOrder::Increasing
         );
         assert!(bytes.iter().all(|b| *b == bytes[0]));
-    }
-
-    #[test]
-    fn failed_write_keeps_old_file() {
-        let dir = std::env::temp_dir().join(format!("directlab-film2-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("keep.txt");
-        std::fs::write(&path, "good").unwrap();
-        let r = write_atomic(&path, |tmp| {
-            std::fs::write(tmp, "half").unwrap();
-            Err("boom".into())
-        });
-        assert!(r.is_err());
-        assert_eq!(std::fs::read_to_string(&path).unwrap(), "good");
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -16,6 +16,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod math;
 pub mod metrics;
+pub mod output;
 pub mod plot;
 pub mod render;
 pub mod report;

@@ -35,8 +35,8 @@ fn scene(c: &Case) -> Scene {
 /// The strategy the experiment calls `name`, on this scene.
 fn strategy(exp: &Resolved, scene: &Scene, name: &str) -> Strategy {
     let spec = exp.exp.strategies.iter().find(|s| s.name == name).unwrap();
-    spec.args()
-        .apply(Strategy::from_desc(&scene.desc.integrator))
+    spec.on(Strategy::from_desc(&scene.desc.integrator))
+        .unwrap()
 }
 
 /// `directlab ARGS --out OUT`.

@@ -17,6 +17,7 @@ fn render_with(scene: &Scene, s: Strategy, spp: u32, seed: u64) -> RenderOutput 
         &RenderSettings {
             spp,
             seed,
+            first_sample: 0,
             threads: None,
             progress: false,
         },

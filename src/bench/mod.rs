@@ -27,24 +27,24 @@ pub struct BenchArgs {
     #[arg(long = "scene")]
     pub scenes: Vec<PathBuf>,
     /// Thread counts to measure.
-    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = crate::render::parse_threads)]
     pub threads: Vec<usize>,
     /// Samples per pixel of each timed render.
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: u32,
     /// Image resolution of scenes that declare a `res` default (the bundled Cornell box); other
     /// scenes keep their own size (the Veach scene: 768x512).
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..))]
     pub res: u32,
     /// Timed repetitions; the fastest is reported (the others measure interference). Five,
     /// because on a shared 2-core VM three still let one slow spell decide a 2-thread number.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
     pub repeat: u32,
     /// Samples per pixel of each timed render of the triangle and emitter sweeps (64x64
     /// pixels). At 64 spp a render lasted 25-60 ms and its speed spread by up to 50 % between
     /// repetitions on this VM (scheduler ticks, thread start-up), which best-of-5 did not
     /// remove; at 512 (0.2-0.4 s) the spread is 3-6 %.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
     pub sweep_spp: u32,
     /// Largest triangle count of the triangle-scaling sweep (1e3, 1e4, ... up to this).
     #[arg(long, default_value_t = 1_000_000)]
@@ -169,7 +169,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             unit: "bytes",
         });
     }
-    crate::film::write_atomic(&a.out, |tmp| {
+    crate::output::write_atomic(&a.out, |tmp| {
         let mut w = csv::Writer::from_path(tmp).map_err(|e| format!("{}: {e}", a.out.display()))?;
         for r in &rows {
             w.serialize(r).map_err(|e| e.to_string())?;

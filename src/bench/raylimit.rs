@@ -427,6 +427,7 @@ pub fn measure_interleaved(
     let settings = RenderSettings {
         spp,
         seed: MIX_SEED,
+        first_sample: 0,
         threads: Some(1),
         progress: false,
     };

@@ -146,6 +146,7 @@ fn throughputs(
         let settings = RenderSettings {
             spp,
             seed: 1,
+            first_sample: 0,
             threads: Some(t),
             progress: false,
         };

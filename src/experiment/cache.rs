@@ -8,7 +8,6 @@
 
 use crate::film::{self, Image};
 use crate::integrator::Strategy;
-use crate::render::{render, RenderSettings};
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -188,16 +187,27 @@ pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, St
         req.spp,
         dir.display()
     );
-    let out = render(
-        req.scene,
-        req.strategy,
-        &RenderSettings {
+    let acc = super::chunks::render_chunked(
+        dir,
+        &super::chunks::ChunkedRender {
+            scene: req.scene,
+            strategy: req.strategy,
             spp: req.spp,
             seed: req.seed,
             threads: req.threads,
             progress: req.progress,
+            key: &req.key,
         },
-    );
+    )?;
+    let (mean, variance) = acc.images();
+    let out = crate::render::RenderOutput {
+        mean,
+        variance,
+        spp: req.spp,
+        seconds: acc.seconds,
+        busy_seconds: acc.seconds,
+        non_finite_samples: acc.non_finite_samples,
+    };
     let (mse_floor, relmse_floor) = noise_floor(&out.mean, &out.variance, req.relmse_epsilon);
     let info = ReferenceInfo {
         key: req.key.clone(),
@@ -216,7 +226,7 @@ pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, St
     film::write_exr(&v, &out.variance)?;
     // The JSON goes last: its presence marks a complete entry.
     let json = serde_json::to_string_pretty(&info).map_err(|e| e.to_string())?;
-    film::write_atomic(&j, |tmp| {
+    crate::output::write_atomic(&j, |tmp| {
         std::fs::write(tmp, json).map_err(|e| format!("{}: {e}", j.display()))
     })?;
     prune(dir, &req.key);

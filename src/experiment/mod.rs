@@ -4,6 +4,7 @@
 pub mod analysis;
 pub mod cache;
 pub mod cases;
+pub mod chunks;
 pub mod figures;
 pub mod leftout;
 mod measure;

@@ -2,7 +2,7 @@
 //! sweep resumes where it stopped. Rows carry a `context` hash (reference key + epsilon): rows
 //! made against another scene, reference or epsilon are dropped on load, never mixed in.
 
-use crate::film::write_atomic;
+use crate::output::write_atomic;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

@@ -60,6 +60,7 @@ fn execute(ctx: &Ctx, job: &Job) -> Result<Row, String> {
         &RenderSettings {
             spp: job.spp,
             seed: job.seed,
+            first_sample: 0,
             threads: ctx.threads,
             progress: false,
         },
@@ -146,8 +147,8 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
         .exp
         .strategies
         .iter()
-        .map(|s| (s.name.clone(), s.args().apply(base)))
-        .collect();
+        .map(|s| Ok((s.name.clone(), s.on(base)?)))
+        .collect::<Result<_, String>>()?;
     let (kept, omitted) = leave_out(&listed, &SceneTraits::of(&scene));
     for o in &omitted {
         eprintln!(
@@ -158,7 +159,11 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
 
     let x = &exp.exp;
     let eps = x.metrics.relmse_epsilon;
-    let ref_strategy = x.reference.strategy.apply(base);
+    let ref_strategy = x
+        .reference
+        .strategy
+        .apply(base)
+        .map_err(|e| format!("[reference]: {e}"))?;
     let (key, reference) = match (exp.cases[0].value, x.reference.spp) {
         (Some(v), _) => {
             let key = cache::constant_key(exp.scene(), exp.defines(), v, &base)?;

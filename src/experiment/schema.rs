@@ -81,6 +81,16 @@ impl StrategySpec {
             bsdf_samples: self.bsdf_samples,
         }
     }
+
+    /// The strategy this entry names, on the scene's own settings `base`.
+    pub fn on(
+        &self,
+        base: crate::integrator::Strategy,
+    ) -> Result<crate::integrator::Strategy, String> {
+        self.args()
+            .apply(base)
+            .map_err(|e| format!("strategy '{}': {e}", self.name))
+    }
 }
 
 #[derive(Clone, Debug, Deserialize)]

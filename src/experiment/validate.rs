@@ -56,6 +56,9 @@ pub(super) fn cases(exp: &Experiment, file: &Path) -> Result<Vec<Case>, String> 
     Ok(v)
 }
 
+/// The longest equal-time budget accepted: anything longer is a typo, not an experiment.
+const MAX_EQUAL_TIME_SECONDS: f64 = 7.0 * 86400.0;
+
 pub(super) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
     let fail = |m: String| Err(format!("{}: {m}", file.display()));
     if exp.spp.is_empty() || exp.spp.contains(&0) {
@@ -98,9 +101,40 @@ pub(super) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
         return fail(format!("strategy name '{}' is used twice", w[0]));
     }
     if let Some(et) = &exp.equal_time {
-        if et.seconds.iter().any(|s| !(*s > 0.0)) || et.seeds == 0 {
-            return fail("equal_time needs positive seconds and seeds >= 1".into());
+        if let Some(s) = et
+            .seconds
+            .iter()
+            .find(|s| !(**s > 0.0 && **s <= MAX_EQUAL_TIME_SECONDS))
+        {
+            return fail(format!(
+                "equal_time.seconds = {s}: expected a budget in (0, {MAX_EQUAL_TIME_SECONDS}] \
+                 seconds (a week)"
+            ));
         }
+        if et.seeds == 0 {
+            return fail("equal_time.seeds must be at least 1".into());
+        }
+    }
+    if let Some(v) = exp
+        .figures
+        .exposure
+        .filter(|v| !(v.is_finite() && *v > 0.0))
+    {
+        return fail(format!(
+            "figures.exposure = {v}: expected a finite positive multiplier (1 shows radiance as \
+             rendered)"
+        ));
+    }
+    if let Some(v) = exp
+        .figures
+        .progression
+        .iter()
+        .find(|v| !exp.spp.contains(v))
+    {
+        return fail(format!(
+            "figures.progression: {v} is not one of the sweep's spp {:?}",
+            exp.spp
+        ));
     }
     for c in &exp.figures.crops {
         let ok = c.x >= 0.0

@@ -21,8 +21,8 @@ impl Strategy {
         Strategy {
             kind: d.strategy,
             heuristic: d.heuristic,
-            emitter_samples: d.emitter_samples.max(1),
-            bsdf_samples: d.bsdf_samples.max(1),
+            emitter_samples: d.emitter_samples,
+            bsdf_samples: d.bsdf_samples,
             selection: EmitterSelection::Uniform,
             light_sampling: LightSampling::Area,
             hide_emitters: d.hide_emitters,

@@ -46,6 +46,7 @@ fn settings(spp: u32, seed: u64) -> RenderSettings {
     RenderSettings {
         spp,
         seed,
+        first_sample: 0,
         threads: None,
         progress: false,
     }

@@ -181,7 +181,7 @@ pub fn write_chart(stem: &Path, c: &LogLogChart) -> Result<(), String> {
         c,
     )
     .map_err(|m| format!("{}: {m}", svg.display()))?;
-    crate::film::write_atomic(&svg, |tmp| {
+    crate::output::write_atomic(&svg, |tmp| {
         std::fs::write(tmp, &text).map_err(|e| format!("{}: {e}", svg.display()))
     })
 }

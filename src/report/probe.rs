@@ -5,7 +5,7 @@
 pub use super::probe_table::{critical, table, table_spp, TableRow, BIASED, NON_FINITE, OK, TAIL};
 use crate::experiment::analysis::metric_name;
 use crate::experiment::probe::ProbeOutcome;
-use crate::film::write_atomic;
+use crate::output::write_atomic;
 use std::fmt::Write as _;
 
 fn sci(x: f64) -> String {

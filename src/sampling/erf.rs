@@ -3,14 +3,11 @@
 //! resolution of its f32 uniform number (see `microfacet::SlopeInversion`), and the chi-square
 //! tests of the sampled densities cannot see errors of a few 1e-7.
 
-#[cfg(test)]
-use super::elementary::exp;
-use super::elementary::{horner, ln};
+use super::elementary::{exp, horner, ln};
 
 /// Complementary error function, relative error below 2.5e-7 for |x| <= 9 (0 beyond ~9.3,
 /// where exp(-x^2) leaves f32's normal range). The renderer calls `erfc_from_exp`; this and
-/// `erf` are the plain forms its tests check against.
-#[cfg(test)]
+/// `erf` are the plain forms (the Gaussian pixel filter uses `erf`).
 pub fn erfc(x: f32) -> f32 {
     erfc_from_exp(x, exp(-x * x))
 }
@@ -58,7 +55,6 @@ pub fn erfc_from_exp(x: f32, e: f32) -> f32 {
     }
 }
 
-#[cfg(test)]
 pub fn erf(x: f32) -> f32 {
     1.0 - erfc(x)
 }

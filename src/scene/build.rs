@@ -240,6 +240,12 @@ impl Scene {
                         let areas: Vec<f64> = (0..m.indices.len())
                             .map(|t| m.triangle_area(t) as f64)
                             .collect();
+                        if let Some(t) = areas.iter().position(|a| !a.is_finite()) {
+                            return Err(err(o, format!(
+                                "emitter triangle {t}'s area overflows single precision (more than {:e}): the scene is too large for f32; scale it down",
+                                f32::MAX
+                            )));
+                        }
                         let degenerate = areas.iter().filter(|a| **a == 0.0).count();
                         let table = AliasTable::new(&areas).ok_or_else(|| {
                             err(
@@ -256,6 +262,12 @@ impl Scene {
                     }
                     ShapeKind::Sphere(s) => (s.area(), None),
                 };
+                if !area.is_finite() {
+                    return Err(err(o, format!(
+                        "the emitter's total area overflows single precision (more than {:e}): the scene is too large for f32; scale it down",
+                        f32::MAX
+                    )));
+                }
                 if e.radiance == Rgb::ZERO {
                     warnings.push(format!("{o}: emitter has zero radiance"));
                 }

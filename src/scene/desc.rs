@@ -87,6 +87,30 @@ pub enum StrategyKind {
     MisOneSample,
 }
 
+impl StrategyKind {
+    /// The estimator that `emitter_samples` and `bsdf_samples` leave of this one, with
+    /// Mitsuba's meaning of a zero count: MIS without emitter samples is BSDF sampling, MIS
+    /// without BSDF samples is light sampling. A pure strategy whose own technique gets no
+    /// samples would estimate nothing, and is an error.
+    pub fn with_sample_counts(
+        self,
+        emitter_samples: u32,
+        bsdf_samples: u32,
+    ) -> Result<Self, String> {
+        use StrategyKind::*;
+        match (self, emitter_samples, bsdf_samples) {
+            (_, 0, 0) => {
+                Err("emitter_samples and bsdf_samples are both 0: nothing would be sampled".into())
+            }
+            (Light, 0, _) => Err("light sampling with emitter_samples = 0 draws no sample".into()),
+            (Bsdf, _, 0) => Err("BSDF sampling with bsdf_samples = 0 draws no sample".into()),
+            (Mis | MisOneSample, 0, _) => Ok(Bsdf),
+            (Mis | MisOneSample, _, 0) => Ok(Light),
+            (k, _, _) => Ok(k),
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Heuristic {
     Balance,

@@ -26,9 +26,51 @@ pub enum Dialect {
 
 /// Reads a scene file. `defines` are the CLI's `-D name=value` overrides.
 pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<SceneDesc, SceneError> {
-    let xml = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::new(path, format!("cannot read scene file: {e}")))?;
+    let xml = read_text_file(path, MAX_SCENE_BYTES, "scene file")?;
     load_scene_str(&xml, path, defines)
+}
+
+/// The largest scene file read (meshes live in their own files): far above any hand-written
+/// or exported scene, and a bound on what a wrong path (a device, a log) can cost.
+pub const MAX_SCENE_BYTES: u64 = 1 << 30;
+
+/// Reads a text file of at most `limit` bytes. Anything but a regular file (a device such as
+/// `/dev/zero`, a FIFO, a directory) is refused before reading, since it may never end.
+pub fn read_text_file(path: &Path, limit: u64, what: &str) -> Result<String, SceneError> {
+    use std::io::Read;
+    let fail = |m: String| SceneError::new(path, m);
+    let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read {what}: {e}")))?;
+    if !meta.is_file() {
+        return Err(fail(format!(
+            "cannot read {what}: expected a regular file, found {}",
+            if meta.is_dir() {
+                "a directory"
+            } else {
+                "a device, FIFO or socket"
+            }
+        )));
+    }
+    if meta.len() > limit {
+        return Err(fail(format!(
+            "{what} is {} bytes, more than the {limit} accepted",
+            meta.len()
+        )));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    std::fs::File::open(path)
+        .and_then(|f| f.take(limit + 1).read_to_end(&mut bytes))
+        .map_err(|e| fail(format!("cannot read {what}: {e}")))?;
+    if bytes.len() as u64 > limit {
+        return Err(fail(format!(
+            "{what} is more than the {limit} bytes accepted"
+        )));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        fail(format!(
+            "cannot read {what}: not UTF-8 text (invalid byte at offset {})",
+            e.utf8_error().valid_up_to()
+        ))
+    })
 }
 
 /// Reads a scene from a string; `path` names it in messages and relative mesh paths are

@@ -93,9 +93,83 @@ pub fn cube() -> TriMesh {
     mesh
 }
 
+/// The first malformed line of an OBJ file, and why. Checks the statements directlab reads
+/// (v, vn, vt, f): numbers where numbers belong, and face indices (1-based, or negative
+/// relative ones) into the vertices, texture coordinates and normals defined above them.
+pub fn find_obj_error(path: &Path) -> Option<(usize, String)> {
+    use std::io::BufRead;
+    let file = std::fs::File::open(path).ok()?;
+    let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
+    for (i, line) in BufReader::new(file).lines().enumerate() {
+        let lineno = i + 1;
+        let Ok(line) = line else {
+            return Some((lineno, "expected UTF-8 text".into()));
+        };
+        let mut words = line.split_whitespace();
+        let Some(head) = words.next() else {
+            continue;
+        };
+        let args: Vec<&str> = words.collect();
+        let shown = super::xml::clip(line.trim());
+        let numbers = |min: usize, count: &mut i64| -> Option<String> {
+            let ok = args.len() >= min && args.iter().all(|a| a.parse::<f32>().is_ok());
+            *count += 1;
+            (!ok)
+                .then(|| format!("expected '{head}' and at least {min} numbers, found \"{shown}\""))
+        };
+        let err = match head {
+            "v" => numbers(3, &mut nv),
+            "vt" => numbers(1, &mut nt),
+            "vn" => numbers(3, &mut nn),
+            "f" if args.len() < 3 => Some(format!(
+                "a face needs at least 3 vertices, found \"{shown}\""
+            )),
+            "f" => args.iter().find_map(|v| {
+                let parts: Vec<&str> = v.split('/').collect();
+                let ok = parts.len() <= 3
+                    && parts
+                        .iter()
+                        .zip([nv, nt, nn])
+                        .enumerate()
+                        .all(|(k, (p, n))| {
+                            if p.is_empty() {
+                                return k > 0; // v//vn: the texture index may be left out
+                            }
+                            p.parse::<i64>().is_ok_and(|i| i != 0 && i <= n && -i <= n)
+                        });
+                (!ok).then(|| {
+                    format!(
+                        "face vertex '{}' is not an index into the {nv} vertices (or {nt} \
+                         texture coordinates, {nn} normals) defined above it",
+                        super::xml::clip(v)
+                    )
+                })
+            }),
+            _ => None,
+        };
+        if let Some(e) = err {
+            return Some((lineno, e));
+        }
+    }
+    None
+}
+
 /// Loads a Wavefront OBJ, merging all its objects/groups into one mesh (as Mitsuba and Nori
 /// do). Materials are not read. Messages name the OBJ file; the caller adds the XML position.
 pub fn load_obj(path: &Path) -> Result<TriMesh, String> {
+    let meta = std::fs::metadata(path)
+        .map_err(|e| format!("cannot open mesh file '{}': {e}", path.display()))?;
+    if !meta.is_file() {
+        return Err(format!(
+            "cannot read mesh file '{}': expected a regular file",
+            path.display()
+        ));
+    }
+    // Checked first: tobj names no line in its errors, and silently accepts face indices past
+    // the vertices defined (it read `f 1 2 4` after three vertices as a degenerate triangle).
+    if let Some((line, what)) = find_obj_error(path) {
+        return Err(format!("{}:{line}: {what}", path.display()));
+    }
     let file = std::fs::File::open(path)
         .map_err(|e| format!("cannot open mesh file '{}': {e}", path.display()))?;
     let opts = tobj::LoadOptions {
@@ -253,6 +327,34 @@ mod tests {
         let inf = dir.join("inf.obj");
         std::fs::write(&inf, "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n").unwrap();
         assert!(load_obj(&inf).unwrap_err().contains("not finite"));
+
+        // tobj's own messages name no line: the file and line come from find_obj_error.
+        for (text, line, what) in [
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\n# c\nf 1 2 x\n",
+                5,
+                "face vertex 'x'",
+            ),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", 4, "face vertex '4'"),
+            (
+                "v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n",
+                2,
+                "at least 3 numbers",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n",
+                4,
+                "at least 3 vertices",
+            ),
+        ] {
+            let bad = dir.join("bad.obj");
+            std::fs::write(&bad, text).unwrap();
+            let e = load_obj(&bad).unwrap_err();
+            let want = format!("{}:{line}: ", bad.display());
+            assert!(e.starts_with(&want) && e.contains(what), "{text:?}: {e}");
+        }
+        let e = load_obj(Path::new("/dev/zero")).unwrap_err();
+        assert!(e.contains("expected a regular file"), "{e}");
 
         let e = load_obj(&dir.join("absent.obj")).unwrap_err();
         assert!(e.contains("absent.obj"), "{e}");

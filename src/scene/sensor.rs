@@ -105,9 +105,9 @@ impl<'a> Loader<'a> {
             &mut self.warnings,
         );
         p.finish()?;
-        if emitter_samples == 0 && bsdf_samples == 0 {
-            return Err(e.err("emitter_samples and bsdf_samples are both 0"));
-        }
+        let strategy = strategy
+            .with_sample_counts(emitter_samples, bsdf_samples)
+            .map_err(|m| e.err(m))?;
         Ok(IntegratorDesc {
             strategy,
             heuristic,

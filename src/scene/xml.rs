@@ -5,7 +5,7 @@
 //! later stage build a precise error without access to the original document.
 
 use super::error::SceneError;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::rc::Rc;
 
@@ -85,14 +85,25 @@ impl Element {
     }
 }
 
+/// `s` for a message: in full up to 60 characters, else its start and its length, so a
+/// megabyte-long attribute is not echoed back whole.
+pub fn clip(s: &str) -> String {
+    const KEEP: usize = 60;
+    if s.chars().count() <= KEEP {
+        return s.to_string();
+    }
+    let head: String = s.chars().take(KEEP - 20).collect();
+    format!("{head}... ({} characters)", s.chars().count())
+}
+
 /// Parses one finite number. NaN and infinities are rejected here, once, so no later stage has
 /// to think about them.
 pub fn parse_float(s: &str) -> Result<f32, String> {
     let t = s.trim();
     match t.parse::<f32>() {
         Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(format!("expected a finite number, found \"{t}\"")),
-        Err(_) => Err(format!("expected a number, found \"{t}\"")),
+        Ok(_) => Err(format!("expected a finite number, found \"{}\"", clip(t))),
+        Err(_) => Err(format!("expected a number, found \"{}\"", clip(t))),
     }
 }
 
@@ -111,7 +122,7 @@ pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
         other => Err(format!(
             "expected 1 or 3 numbers, found {} in \"{}\"",
             other.len(),
-            s.trim()
+            clip(s.trim())
         )),
     }
 }
@@ -119,14 +130,17 @@ pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
 pub fn parse_int(s: &str) -> Result<i64, String> {
     let t = s.trim();
     t.parse::<i64>()
-        .map_err(|_| format!("expected an integer, found \"{t}\""))
+        .map_err(|_| format!("expected an integer, found \"{}\"", clip(t)))
 }
 
 pub fn parse_bool(s: &str) -> Result<bool, String> {
     match s.trim().to_ascii_lowercase().as_str() {
         "true" => Ok(true),
         "false" => Ok(false),
-        _ => Err(format!("expected true or false, found \"{}\"", s.trim())),
+        _ => Err(format!(
+            "expected true or false, found \"{}\"",
+            clip(s.trim())
+        )),
     }
 }
 
@@ -146,7 +160,7 @@ pub fn normalize_name(name: &str) -> String {
 }
 
 /// Replaces every `$name` by its value; an undefined name is reported by name.
-fn substitute(value: &str, params: &HashMap<String, String>) -> Result<String, String> {
+fn substitute(value: &str, params: &Params) -> Result<String, String> {
     let mut out = String::with_capacity(value.len());
     let mut rest = value;
     while let Some(i) = rest.find('$') {
@@ -161,8 +175,11 @@ fn substitute(value: &str, params: &HashMap<String, String>) -> Result<String, S
             continue;
         }
         let name = &after[..len];
-        match params.get(name) {
-            Some(v) => out.push_str(v),
+        match params.values.get(name) {
+            Some(v) => {
+                params.used.borrow_mut().insert(name.to_string());
+                out.push_str(v)
+            }
             None => {
                 return Err(format!(
                     "'${name}' is not defined: add <default name=\"{name}\" value=\"...\"/> \
@@ -176,9 +193,40 @@ fn substitute(value: &str, params: &HashMap<String, String>) -> Result<String, S
     Ok(out)
 }
 
+/// The `$name` parameters of a document, and which of them an attribute used.
+struct Params {
+    values: HashMap<String, String>,
+    used: std::cell::RefCell<HashSet<String>>,
+}
+
+/// Line numbers of byte offsets, from a table of line starts: one binary search per element
+/// (roxmltree's `text_pos_at` scans from the document's start each time, which made loading
+/// quadratic in the element count).
+struct Lines(Vec<usize>);
+
+impl Lines {
+    fn new(text: &str) -> Self {
+        let starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        Lines(starts)
+    }
+
+    /// 1-based line of byte offset `pos`.
+    fn of(&self, pos: usize) -> u32 {
+        self.0.partition_point(|&s| s <= pos) as u32
+    }
+}
+
+/// The deepest element nesting accepted. Scenes nest a handful of levels; the limit keeps a
+/// malicious or broken file from exhausting the stack of the recursive conversion.
+pub const MAX_DEPTH: usize = 256;
+
 /// Parses `xml` into an element tree. `<default>` elements directly under the root define
 /// parameters (in document order, so one default may use an earlier one); `defines` override
-/// them, as Mitsuba's `-D` does, and are visible to the defaults that use them.
+/// them, as Mitsuba's `-D` does, and are visible to the defaults that use them. A define that
+/// the document neither declares with `<default>` nor uses as `$name` is an error: it is
+/// almost always a typo that would otherwise be silently ignored.
 pub fn parse_document(
     xml: &str,
     file: &Path,
@@ -195,36 +243,100 @@ pub fn parse_document(
         element: None,
         message: format!("malformed XML: {e}"),
     })?;
-    let file: Rc<Path> = Rc::from(file);
+    let cx = Context {
+        file: Rc::from(file),
+        lines: Lines::new(xml),
+    };
     let root = doc.root_element();
+    check_depth(&cx, root)?;
 
-    let mut params: HashMap<String, String> = defines.iter().cloned().collect();
+    let mut params = Params {
+        values: defines.iter().cloned().collect(),
+        used: Default::default(),
+    };
+    let mut declared = HashSet::new();
     for node in root.children().filter(|n| n.is_element()) {
         if node.tag_name().name() != "default" {
             continue;
         }
-        let raw = convert(&doc, node, &file, None)?;
+        let raw = convert(&cx, node, None)?;
         raw.check_attrs(&["name", "value"])?;
         let name = raw.required_attr("name")?.to_string();
         let value = substitute(raw.required_attr("value")?, &params).map_err(|m| raw.err(m))?;
+        declared.insert(name.clone());
         if !defines.iter().any(|(k, _)| *k == name) {
-            params.insert(name, value);
+            params.values.insert(name, value);
         }
     }
-    convert(&doc, root, &file, Some(&params))
+    let tree = convert(&cx, root, Some(&params))?;
+    let used = params.used.borrow();
+    if let Some((name, _)) = defines
+        .iter()
+        .find(|(k, _)| !declared.contains(k) && !used.contains(k))
+    {
+        let mut known: Vec<&String> = declared.iter().collect();
+        known.sort();
+        let known = if known.is_empty() {
+            "it declares none".to_string()
+        } else {
+            format!(
+                "it declares {}",
+                known
+                    .iter()
+                    .map(|k| k.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        };
+        return Err(SceneError::new(
+            file,
+            format!(
+                "parameter '{}' is set (-D or an experiment's defines) but the scene neither \
+                 declares it with <default name=\"{0}\"> nor uses ${0}; {known}",
+                clip(name)
+            ),
+        ));
+    }
+    Ok(tree)
+}
+
+/// What every element's conversion reads.
+struct Context {
+    file: Rc<Path>,
+    lines: Lines,
+}
+
+/// Refuses nesting deeper than [`MAX_DEPTH`], walking the tree without recursion.
+fn check_depth(cx: &Context, root: roxmltree::Node) -> Result<(), SceneError> {
+    let mut stack = vec![(root, 1usize)];
+    while let Some((node, depth)) = stack.pop() {
+        if depth > MAX_DEPTH {
+            return Err(SceneError {
+                file: cx.file.to_path_buf(),
+                line: Some(cx.lines.of(node.range().start)),
+                element: Some(format!("<{}>", clip(node.tag_name().name()))),
+                message: format!("elements nest deeper than {MAX_DEPTH} levels"),
+            });
+        }
+        stack.extend(
+            node.children()
+                .filter(|n| n.is_element())
+                .map(|c| (c, depth + 1)),
+        );
+    }
+    Ok(())
 }
 
 fn convert(
-    doc: &roxmltree::Document,
+    cx: &Context,
     node: roxmltree::Node,
-    file: &Rc<Path>,
-    params: Option<&HashMap<String, String>>,
+    params: Option<&Params>,
 ) -> Result<Element, SceneError> {
     let tag = node.tag_name().name().to_string();
-    let line = doc.text_pos_at(node.range().start).row;
-    let mut display = format!("<{tag}");
+    let line = cx.lines.of(node.range().start);
+    let mut display = format!("<{}", clip(&tag));
     for a in node.attributes() {
-        display.push_str(&format!(" {}=\"{}\"", a.name(), a.value()));
+        display.push_str(&format!(" {}=\"{}\"", clip(a.name()), clip(a.value())));
     }
     display.push('>');
     let mut elem = Element {
@@ -233,7 +345,7 @@ fn convert(
         children: Vec::new(),
         line,
         display,
-        file: file.clone(),
+        file: cx.file.clone(),
     };
     // <default> values were substituted when the parameter table was built.
     let params = params.filter(|_| elem.tag != "default");
@@ -245,7 +357,7 @@ fn convert(
         elem.attrs.push((a.name().to_string(), value));
     }
     for child in node.children().filter(|n| n.is_element()) {
-        elem.children.push(convert(doc, child, file, params)?);
+        elem.children.push(convert(cx, child, params)?);
     }
     Ok(elem)
 }

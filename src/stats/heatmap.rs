@@ -6,8 +6,8 @@
 //! against noise. The v parameter (cos theta, y, r^2) increases upwards.
 
 use super::chi2::{Chi2Result, Grid};
-use image::{ImageError, ImageFormat, Rgb, RgbImage};
-use std::path::{Path, PathBuf};
+use image::{ImageFormat, Rgb, RgbImage};
+use std::path::Path;
 
 /// Pixels between panels.
 const GAP: u32 = 4;
@@ -96,15 +96,14 @@ pub fn render(observed: &Grid, expected: &Grid, cell_px: u32) -> RgbImage {
     img
 }
 
-/// Writes [`render`] of a run to `path` as PNG, via `path.tmp` and a rename so readers never
-/// see a half-written file.
-pub fn write(path: &Path, result: &Chi2Result, cell_px: u32) -> Result<(), ImageError> {
+/// Writes [`render`] of a run to `path` as PNG, through [`crate::output::write_atomic`] so
+/// readers never see a half-written file.
+pub fn write(path: &Path, result: &Chi2Result, cell_px: u32) -> Result<(), String> {
     let img = render(&result.observed, &result.expected, cell_px);
-    let mut tmp = PathBuf::from(path).into_os_string();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    img.save_with_format(&tmp, ImageFormat::Png)?;
-    std::fs::rename(&tmp, path).map_err(ImageError::IoError)
+    crate::output::write_atomic(path, |tmp| {
+        img.save_with_format(tmp, ImageFormat::Png)
+            .map_err(|e| format!("{}: cannot write PNG: {e}", path.display()))
+    })
 }
 
 #[cfg(test)]
@@ -144,7 +143,11 @@ mod tests {
         write(&path, &r, 6).unwrap();
         let img = image::open(&path).unwrap().to_rgb8();
         assert_eq!(img.dimensions(), (3 * 11 * 6 + 2 * GAP, 21 * 6));
-        assert!(!dir.join("chi2.png.tmp").exists());
+        assert_eq!(
+            std::fs::read_dir(&dir).unwrap().count(),
+            1,
+            "a temporary file was left"
+        );
         // Lower hemisphere: samples where the pdf is 0 are drawn saturated red.
         assert_eq!(
             *img.get_pixel(2 * (66 + GAP) + 3, 21 * 6 - 3),

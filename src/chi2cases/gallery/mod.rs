@@ -102,7 +102,7 @@ mod tests {
     fn regenerate_bug_gallery() {
         let md = markdown(&run_table());
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/bug-gallery.md");
-        crate::film::write_atomic(&path, |tmp| {
+        crate::output::write_atomic(&path, |tmp| {
             std::fs::write(tmp, &md).map_err(|e| e.to_string())
         })
         .unwrap();

@@ -5,8 +5,8 @@
 
 use super::samples::pixel_samples;
 use super::stats::z_score;
-use crate::film::write_atomic;
 use crate::integrator::{Direct, Strategy};
+use crate::output::write_atomic;
 use crate::render::{render, RenderSettings};
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
@@ -44,6 +44,7 @@ pub fn measure(
     let settings = RenderSettings {
         spp,
         seed,
+        first_sample: 0,
         threads,
         progress: false,
     };

@@ -148,8 +148,8 @@ pub fn run_probe(exp: Resolved, opts: &RunOptions) -> Result<ProbeOutcome, Strin
         let listed: Vec<(String, Strategy)> = x
             .strategies
             .iter()
-            .map(|s| (s.name.clone(), s.args().apply(base)))
-            .collect();
+            .map(|s| Ok((s.name.clone(), s.on(base)?)))
+            .collect::<Result<_, String>>()?;
         let (kept, omitted) = leave_out(&listed, &SceneTraits::of(&scene));
         warned_checks.extend(warned);
         cases.push(CaseRun {
@@ -348,7 +348,7 @@ fn run_accumulation(
             .iter()
             .find(|s| &s.name == name)
             .expect("validated: the strategy exists");
-        let s = spec.args().apply(base);
+        let s = spec.on(base)?;
         if let Some(r) = old.iter().find(|r| r.strategy == s.label()) {
             out.push(r.clone());
             continue;

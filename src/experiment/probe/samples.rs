@@ -71,6 +71,7 @@ mod tests {
         let settings = RenderSettings {
             spp: 64,
             seed: 9,
+            first_sample: 0,
             threads: Some(1),
             progress: false,
         };
