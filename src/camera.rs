@@ -174,27 +174,77 @@ mod tests {
         Camera::new(&desc, &film)
     }
 
-    /// The film's corners look along (+-tan_x, +-tan_y, 1) in camera space, the tangents of
-    /// the half field of view that each axis rule gives.
+    /// Mitsuba's conventions, computed by hand: film point (fx, fy), in pixels from the top
+    /// left, looks along (tx (1 - 2 fx / w), ty (1 - 2 fy / h), 1) in camera space (image left
+    /// is camera +x, image top is +y), where the half-angle tangents (tx, ty) follow the fov
+    /// axis rule: `x` and `y` fix that axis, `smaller` / `larger` pick the film's smaller /
+    /// larger side, `diagonal` fixes the half diagonal. Checked at the four corners and a
+    /// pixel centre, on landscape and portrait films, with fov 90 degrees (tangent 1).
     #[test]
-    fn fov_axes() {
+    fn fov_axes_on_landscape_and_portrait_films() {
+        use FovAxis::*;
         let cases = [
-            (FovAxis::X, 200, 100, (1.0, 0.5)),
-            (FovAxis::Y, 200, 100, (2.0, 1.0)),
-            (FovAxis::Smaller, 200, 100, (2.0, 1.0)),
-            (FovAxis::Larger, 200, 100, (1.0, 0.5)),
-            (FovAxis::Diagonal, 300, 400, (0.6, 0.8)),
+            (X, 200, 100, (1.0, 0.5)),
+            (X, 100, 200, (1.0, 2.0)),
+            (Y, 200, 100, (2.0, 1.0)),
+            (Y, 100, 200, (0.5, 1.0)),
+            (Smaller, 200, 100, (2.0, 1.0)),
+            (Smaller, 100, 200, (1.0, 2.0)),
+            (Larger, 200, 100, (1.0, 0.5)),
+            (Larger, 100, 200, (0.5, 1.0)),
+            (Diagonal, 300, 400, (0.6, 0.8)),
+            (Diagonal, 400, 300, (0.8, 0.6)),
         ];
         for (axis, w, h, (tx, ty)) in cases {
             let c = camera(axis, w, h);
-            for (fx, fy) in [(0.0, 0.0), (w as f32, h as f32), (0.0, h as f32)] {
+            let (wf, hf) = (w as f32, h as f32);
+            let points = [(0.0, 0.0), (wf, 0.0), (0.0, hf), (wf, hf), (10.5, 20.5)];
+            for (fx, fy) in points {
+                let want = Vec3::new(tx * (1.0 - 2.0 * fx / wf), ty * (1.0 - 2.0 * fy / hf), 1.0);
                 let d = c.direction(fx, fy);
-                let want = Vec3::new(tx, ty, 1.0);
-                assert!((d.abs() - want).length() < 1e-6, "{axis:?} {d} vs {want}");
+                assert!(
+                    (d - want).length() < 1e-5,
+                    "{axis:?} {w}x{h} at ({fx}, {fy}): {d} vs {want}"
+                );
             }
-            let mid = c.direction(w as f32 / 2.0, h as f32 / 2.0);
-            assert!((mid - Vec3::Z).length() < 1e-6, "{axis:?} centre {mid}");
         }
+    }
+
+    /// Handedness through to_world: a camera at (1, 2, 3) looking along world -x with up +y
+    /// (Mitsuba's look_at: left = up x forward = +z) sees world +z at the image's left edge and
+    /// +y at its top, and the centre ray starts at the origin.
+    #[test]
+    fn look_at_orientation_is_mitsubas() {
+        let eye = Vec3::new(1.0, 2.0, 3.0);
+        let c = Camera::new(
+            &CameraDesc {
+                to_world: crate::math::look_at(eye, eye - Vec3::X, Vec3::Y),
+                fov_degrees: 90.0,
+                fov_axis: FovAxis::X,
+                near_clip: 0.01,
+                far_clip: 100.0,
+            },
+            &FilmDesc {
+                width: 64,
+                height: 32,
+                filter: FilterDesc::Box,
+            },
+        );
+        let n = |v: Vec3| v.normalize();
+        let close = |a: Vec3, b: Vec3| (n(a) - n(b)).length() < 1e-5;
+        assert!(close(c.direction(32.0, 16.0), -Vec3::X));
+        assert!(
+            close(c.direction(0.0, 16.0), Vec3::new(-1.0, 0.0, 1.0)),
+            "left is +z"
+        );
+        assert!(close(c.direction(64.0, 16.0), Vec3::new(-1.0, 0.0, -1.0)));
+        assert!(
+            close(c.direction(32.0, 0.0), Vec3::new(-1.0, 0.5, 0.0)),
+            "top is +y"
+        );
+        assert!(close(c.direction(32.0, 32.0), Vec3::new(-1.0, -0.5, 0.0)));
+        let r = c.generate_ray(31, 15, &mut Rng::new(1, 2));
+        assert_eq!(r.o, eye);
     }
 
     #[test]
