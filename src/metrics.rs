@@ -128,6 +128,29 @@ mod tests {
         assert!((rel_mse(&a, &r, 1.0) - 0.125).abs() < 1e-12);
     }
 
+    /// Hand-computed on a 2x1 image whose channels all differ, so that a channel or pixel mix-up,
+    /// a wrong divisor or the wrong image's value in relMSE's denominator changes the number.
+    #[test]
+    fn mse_and_rel_mse_by_hand_per_channel() {
+        let img = Image {
+            width: 2,
+            height: 1,
+            data: vec![[1.0, 2.0, 3.0], [0.0, 0.5, 4.0]],
+        };
+        let r = Image {
+            width: 2,
+            height: 1,
+            data: vec![[1.0, 1.0, 1.0], [2.0, 0.5, 2.0]],
+        };
+        // Squared errors 0, 1, 4 | 4, 0, 4 over 6 values.
+        assert!((mse(&img, &r) - 13.0 / 6.0).abs() < 1e-12);
+        // Divided by r^2 + 0.5: 1.5, 1.5, 1.5 | 4.5, 0.75, 4.5.
+        let want = (1.0 / 1.5 + 4.0 / 1.5 + 4.0 / 4.5 + 4.0 / 4.5) / 6.0;
+        assert!((rel_mse(&img, &r, 0.5) - want).abs() < 1e-12);
+        // The reference, not the image, is in the denominator.
+        assert!((rel_mse(&r, &img, 0.5) - want).abs() > 0.1);
+    }
+
     #[test]
     fn region_comparison_detects_a_shift_larger_than_the_noise() {
         let var = constant(1e-4);
