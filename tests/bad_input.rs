@@ -530,3 +530,34 @@ fn killed_reference_render_resumes_from_its_checkpoint() {
         "the resumed reference differs from the uninterrupted one"
     );
 }
+
+#[test]
+fn reflectance_above_one_is_warned_about() {
+    let d = scratch("bad-albedo");
+    let s = scene_file(
+        &d,
+        "bright.xml",
+        "<shape type=\"rectangle\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0.5, 1.5, 0.5\"/></bsdf></shape>\n\
+         <shape type=\"rectangle\"><bsdf type=\"conductor\"><rgb name=\"specular_reflectance\" value=\"0.9\"/></bsdf>\
+         <emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter></shape>",
+    );
+    let o = within(
+        directlab()
+            .arg("render")
+            .arg(&s)
+            .args(["--spp", "1", "--out"])
+            .arg(d.join("b.exr")),
+        60,
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("bright.xml:3") && err.contains("reflectance") && err.contains("exceeds 1"),
+        "{err}"
+    );
+    assert_eq!(
+        err.matches("exceeds 1").count(),
+        1,
+        "only the diffuse one: {err}"
+    );
+}

@@ -174,6 +174,17 @@ fn conductor_params(p: &Plugin) -> Result<(Rgb, Rgb, Rgb), SceneError> {
 }
 
 impl<'a> Loader<'a> {
+    /// A reflectance above 1 reflects more light than arrives: legal input (Mitsuba renders
+    /// it), but almost always a mistake (values in 0..255, a wrong unit), so it is said.
+    fn warn_above_one(&mut self, e: &Element, name: &str, v: Vec3) {
+        if v.max_element() > 1.0 {
+            self.warn(
+                e,
+                format!("{name} {v} exceeds 1 in some channel: the material creates energy"),
+            );
+        }
+    }
+
     pub(super) fn bsdf(&mut self, e: &'a Element) -> Result<BsdfDesc, SceneError> {
         let p = Plugin::new(e, &["type", "id", "name"])?;
         let bsdf = match p.ty.as_str() {
@@ -183,9 +194,9 @@ impl<'a> Loader<'a> {
                 if r.is_some() && a.is_some() {
                     return Err(e.err("give either 'reflectance' or 'albedo', not both"));
                 }
-                BsdfDesc::Diffuse {
-                    reflectance: r.or(a).unwrap_or(Vec3::splat(0.5)),
-                }
+                let reflectance = r.or(a).unwrap_or(Vec3::splat(0.5));
+                self.warn_above_one(e, "reflectance", reflectance);
+                BsdfDesc::Diffuse { reflectance }
             }
             "twosided" => {
                 let inner = match p.nested(&["bsdf", "ref"]).as_slice() {
@@ -205,6 +216,7 @@ impl<'a> Loader<'a> {
             }
             "conductor" => {
                 let (eta, k, specular_reflectance) = conductor_params(&p)?;
+                self.warn_above_one(e, "specular_reflectance", specular_reflectance);
                 BsdfDesc::Conductor {
                     eta,
                     k,
@@ -213,6 +225,7 @@ impl<'a> Loader<'a> {
             }
             "roughconductor" => {
                 let (eta, k, specular_reflectance) = conductor_params(&p)?;
+                self.warn_above_one(e, "specular_reflectance", specular_reflectance);
                 let distribution = match p.string("distribution")? {
                     None => MicrofacetDistribution::Beckmann,
                     Some((s, se)) => match s.to_ascii_lowercase().as_str() {
