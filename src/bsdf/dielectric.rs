@@ -100,6 +100,41 @@ mod tests {
         }
     }
 
+    /// The Fresnel reflectance against the textbook formula, written here in f64 without the
+    /// renderer's code: R = (Rs + Rp) / 2 with Rs = ((n1 c_i - n2 c_t) / (n1 c_i + n2 c_t))^2
+    /// and Rp = ((n2 c_i - n1 c_t) / (n2 c_i + n1 c_t))^2; 0.04 at normal incidence on glass
+    /// (1.5) from either side; total internal reflection past the critical angle.
+    #[test]
+    fn fresnel_matches_the_textbook_formula() {
+        let eta = 1.5f64;
+        let textbook = |c: f64| {
+            let (n1, n2, ci) = if c > 0.0 {
+                (1.0, eta, c)
+            } else {
+                (eta, 1.0, -c)
+            };
+            let s2 = (n1 / n2).powi(2) * (1.0 - ci * ci);
+            if s2 >= 1.0 {
+                return 1.0;
+            }
+            let ct = (1.0 - s2).sqrt();
+            let rs = ((n1 * ci - n2 * ct) / (n1 * ci + n2 * ct)).powi(2);
+            let rp = ((n2 * ci - n1 * ct) / (n2 * ci + n1 * ct)).powi(2);
+            (rs + rp) / 2.0
+        };
+        assert!((textbook(1.0) - 0.04).abs() < 1e-12 && (textbook(-1.0) - 0.04).abs() < 1e-12);
+        for c in [
+            1.0, 0.9, 0.7, 0.3, 0.05, -1.0, -0.9, -0.8, -0.75, -0.5, -0.1,
+        ] {
+            let (r, _, _) = fresnel_dielectric(c as f32, eta as f32);
+            assert!(
+                (r as f64 - textbook(c)).abs() < 1e-5,
+                "cos {c}: {r} vs {}",
+                textbook(c)
+            );
+        }
+    }
+
     /// 200k samples per direction: the reflected fraction is binomial, std error
     /// sqrt(R(1-R)/n) <= 1.1e-3; we allow 4.5 standard errors.
     #[test]

@@ -73,6 +73,36 @@ mod tests {
         assert!((a - Rgb::new(0.2, 0.5, 0.9)).abs().max_element() < 1e-5);
     }
 
+    /// Eval alone, by quadrature (no sampler involved): the cosine-weighted integral over the
+    /// hemisphere is the reflectance, at normal and grazing incidence, and eval is reciprocal.
+    #[test]
+    fn eval_integrates_to_the_reflectance_and_is_reciprocal() {
+        let grid = crate::sampling::quadrature::LobeGrid::around_normal(1.0);
+        for wi in [
+            Vec3::Z,
+            Vec3::new(0.3, 0.1, 0.8).normalize(),
+            Vec3::new(0.0, 0.995, 0.0998),
+        ] {
+            let (a, mass) = quadrature(&diffuse(false), wi, &grid);
+            assert!(
+                (a - Rgb::new(0.2, 0.5, 0.9)).abs().max_element() < 1e-3,
+                "{wi}: {a}"
+            );
+            assert!((mass - 1.0).abs() < 1e-3, "{wi}: pdf mass {mass}");
+        }
+        let (wi, wo) = (
+            Vec3::new(0.3, 0.1, 0.8).normalize(),
+            Vec3::new(-0.5, 0.2, 0.6).normalize(),
+        );
+        let m = diffuse(false);
+        assert!(
+            (m.eval(wi, wo) / wo.z - m.eval(wo, wi) / wi.z)
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+    }
+
     #[test]
     fn one_sided_is_black_from_behind_two_sided_is_not() {
         let wi = Vec3::new(0.0, 0.0, -1.0);
