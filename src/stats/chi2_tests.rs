@@ -375,3 +375,54 @@ fn area_light_silhouette_passes_and_missing_cosine_fails() {
     assert!(!r.passed());
     assert!(r.p_value < 1e-6);
 }
+
+/// Kolmogorov-Smirnov distance of sorted values in [0, 1] from Uniform(0, 1).
+fn ks_uniform(sorted: &[f64]) -> f64 {
+    let n = sorted.len() as f64;
+    sorted
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| (p - i as f64 / n).abs().max(((i + 1) as f64 / n - p).abs()))
+        .fold(0.0, f64::max)
+}
+
+/// The engine is calibrated: for a correct sampler its p-values are uniform. 40 seeds of
+/// 20,000 cosine-hemisphere samples on a 10x19 sphere grid: the p-values' KS distance from
+/// Uniform(0, 1) is below the alpha = 0.01 critical value for n = 40 (1.628 / sqrt(40) =
+/// 0.257), and at most 7 of the 40 fall below 0.05 (binomial(40, 0.05) exceeds 7 with
+/// probability 0.0015). An engine with degrees of freedom a quarter too many (as when pooled
+/// cells are counted as categories of their own) piles its p-values up near 1 and fails the
+/// KS test, which the test checks on the same statistics.
+#[test]
+fn p_values_are_uniform_for_a_correct_sampler() {
+    let domain = Sphere {
+        n_phi: 10,
+        n_cos: 19,
+    };
+    let mut p = Vec::new();
+    let mut p_wrong_dof = Vec::new();
+    for seed in 0..40 {
+        let c = Chi2Config {
+            samples: 20_000,
+            seed: 1000 + seed,
+            ..cfg(0.01)
+        };
+        let r = chi2_test(&domain, cosine_hemisphere, cosine_pdf, &c);
+        assert!(r.dof > 0, "{}", r.reason);
+        p.push(r.p_value);
+        p_wrong_dof.push(chi2_sf(r.statistic, r.dof + r.dof / 4));
+    }
+    p.sort_by(f64::total_cmp);
+    p_wrong_dof.sort_by(f64::total_cmp);
+    let (d, d_wrong) = (ks_uniform(&p), ks_uniform(&p_wrong_dof));
+    let rejected = p.iter().filter(|&&x| x < 0.05).count();
+    eprintln!(
+        "chi2 calibration: KS D = {d:.3}, {rejected}/40 below 0.05; dof x 1.25: D = {d_wrong:.3}"
+    );
+    assert!(d < 0.257, "p-values not uniform: D = {d}, {p:?}");
+    assert!(rejected <= 7, "{rejected} of 40 rejected at 0.05");
+    assert!(
+        d_wrong > 0.257,
+        "the KS check cannot see a wrong dof: D = {d_wrong}"
+    );
+}
