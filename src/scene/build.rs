@@ -182,8 +182,9 @@ const SHADOW_TMAX: f32 = 1.0 - 1e-4;
 
 impl Scene {
     pub fn build(desc: SceneDesc) -> Result<Scene, BuildError> {
-        let mut shapes = Vec::new();
-        let mut materials = Vec::new();
+        let n = desc.shapes.len();
+        let mut shapes = Vec::with_capacity(n);
+        let mut materials = Vec::with_capacity(n);
         let mut emitters = Vec::new();
         let mut warnings = desc.warnings.clone();
         for sd in &desc.shapes {

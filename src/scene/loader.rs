@@ -180,7 +180,7 @@ impl<'a> Loader<'a> {
         let mut sensor: Option<(CameraDesc, Option<FilmDesc>, Option<SamplerDesc>)> = None;
         let mut sampler: Option<SamplerDesc> = None;
         let mut integrator: Option<IntegratorDesc> = None;
-        let mut shapes = Vec::new();
+        let mut shapes = Vec::with_capacity(root.children.len());
         let mut point_lights = Vec::new();
         for e in &root.children {
             match e.tag.as_str() {

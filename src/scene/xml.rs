@@ -87,13 +87,13 @@ impl Element {
 
 /// `s` for a message: in full up to 60 characters, else its start and its length, so a
 /// megabyte-long attribute is not echoed back whole.
-pub fn clip(s: &str) -> String {
+pub fn clip(s: &str) -> std::borrow::Cow<'_, str> {
     const KEEP: usize = 60;
-    if s.chars().count() <= KEEP {
-        return s.to_string();
+    if s.len() <= KEEP || s.chars().count() <= KEEP {
+        return s.into();
     }
     let head: String = s.chars().take(KEEP - 20).collect();
-    format!("{head}... ({} characters)", s.chars().count())
+    format!("{head}... ({} characters)", s.chars().count()).into()
 }
 
 /// Parses one finite number. NaN and infinities are rejected here, once, so no later stage has
@@ -334,15 +334,21 @@ fn convert(
 ) -> Result<Element, SceneError> {
     let tag = node.tag_name().name().to_string();
     let line = cx.lines.of(node.range().start);
-    let mut display = format!("<{}", clip(&tag));
+    let mut display = String::with_capacity(64);
+    display.push('<');
+    display.push_str(&clip(&tag));
     for a in node.attributes() {
-        display.push_str(&format!(" {}=\"{}\"", clip(a.name()), clip(a.value())));
+        display.push(' ');
+        display.push_str(&clip(a.name()));
+        display.push_str("=\"");
+        display.push_str(&clip(a.value()));
+        display.push('"');
     }
     display.push('>');
     let mut elem = Element {
         tag,
-        attrs: Vec::new(),
-        children: Vec::new(),
+        attrs: Vec::with_capacity(node.attributes().len()),
+        children: Vec::with_capacity(node.children().filter(|n| n.is_element()).count()),
         line,
         display,
         file: cx.file.clone(),
