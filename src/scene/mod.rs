@@ -49,3 +49,5 @@ pub use loader::{load_scene, load_scene_str, Dialect};
 mod bsdf_ray_tests;
 #[cfg(test)]
 pub(crate) mod bundled_tests;
+#[cfg(test)]
+pub(crate) mod random;
