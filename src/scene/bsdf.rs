@@ -72,6 +72,18 @@ pub(crate) const METALS: &[(&str, [f32; 3], [f32; 3])] = &[
     ("none", [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]),
 ];
 
+/// The BSDF types `bsdf` reads: every one must have a white-furnace case
+/// (`bsdf_furnace_tests`).
+pub(crate) const SUPPORTED_BSDFS: [&str; 7] = [
+    "diffuse",
+    "twosided",
+    "conductor",
+    "roughconductor",
+    "dielectric",
+    "mirror",
+    "microfacet",
+];
+
 const KNOWN_BSDFS: &[&str] = &[
     "plastic",
     "roughplastic",
@@ -295,8 +307,8 @@ impl<'a> Loader<'a> {
             }
             t => {
                 return Err(e.err(format!(
-                    "unknown bsdf type '{t}'; supported: diffuse, twosided, conductor, \
-                     roughconductor, dielectric, mirror, microfacet"
+                    "unknown bsdf type '{t}'; supported: {}",
+                    SUPPORTED_BSDFS.join(", ")
                 )))
             }
         };

@@ -46,6 +46,8 @@ pub use error::SceneError;
 pub use loader::{load_scene, load_scene_str, Dialect};
 
 #[cfg(test)]
+mod bsdf_furnace_tests;
+#[cfg(test)]
 mod bsdf_ray_tests;
 #[cfg(test)]
 pub(crate) mod bundled_tests;
