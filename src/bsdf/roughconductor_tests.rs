@@ -352,8 +352,11 @@ fn eval_tends_to_the_smooth_conductor_and_its_closed_form() {
 
 /// Mitsuba 3's roughconductor albedo, lossless Fresnel, from `experiments/mitsuba_albedo.py`:
 /// (distribution, alpha, [(cos_i, albedo, standard error)]).
+/// (cos_i, albedo, standard error) at four incidences.
+type AlbedoRow = [(f32, f64, f64); 4];
+
 #[rustfmt::skip]
-const MITSUBA_ALBEDO: [(&str, f32, [(f32, f64, f64); 4]); 8] = [
+const MITSUBA_ALBEDO: [(&str, f32, AlbedoRow); 8] = [
     ("beckmann", 0.3, [(1.0, 0.999764, 3.5e-06), (0.7, 0.966028, 7.4e-05), (0.3, 0.900553, 1.2e-04), (0.1, 0.931867, 9.0e-05)]),
     ("beckmann", 0.5, [(1.0, 0.943378, 8.5e-05), (0.7, 0.874125, 1.4e-04), (0.3, 0.892592, 1.2e-04), (0.1, 0.936489, 8.0e-05)]),
     ("beckmann", 0.8, [(1.0, 0.642004, 1.9e-04), (0.7, 0.750994, 1.7e-04), (0.3, 0.871699, 1.2e-04), (0.1, 0.923603, 8.2e-05)]),
