@@ -275,17 +275,49 @@ mod tests {
         assert!((left.tmin * left.d.z - 0.5).abs() < 1e-4);
     }
 
-    /// Kolmogorov-Smirnov test of the Gaussian filter's offsets against the CDF of the
-    /// Gaussian truncated to the radius, per axis, at alpha = 0.01 (critical D = 1.628 /
-    /// sqrt(n)), n = 20000, for a wide and a narrow radius. A radius of 0.01 sd took minutes
-    /// per pixel when the offsets were drawn by rejection.
+    /// Kolmogorov-Smirnov test of every filter's offsets against the filter's CDF per axis
+    /// (box: uniform on [-1/2, 1/2]; tent: triangular on [-r, r]; Gaussian: truncated to
+    /// the radius), at alpha = 0.01 (critical D = 1.628 / sqrt(n)), n = 20000, for wide and
+    /// narrow radii. A Gaussian radius of 0.01 sd took minutes per pixel when the offsets
+    /// were drawn by rejection.
     #[test]
-    fn gaussian_filter_offsets_follow_the_truncated_gaussian() {
+    fn filter_offsets_follow_the_filter() {
         use crate::sampling::erf::erf;
         let n = 20_000;
-        for (stddev, radius) in [(0.5f32, 2.0f32), (0.5, 0.6), (50.0, 0.5)] {
+        let gaussian = |stddev: f32, radius: f32| FilterDesc::Gaussian { stddev, radius };
+        let filters = [
+            FilterDesc::Box,
+            FilterDesc::Tent { radius: 0.5 },
+            FilterDesc::Tent { radius: 2.5 },
+            gaussian(0.5, 2.0),
+            gaussian(0.5, 0.6),
+            gaussian(50.0, 0.5),
+        ];
+        for filter in filters {
+            let cdf = |x: f64| -> f64 {
+                let f = match filter {
+                    FilterDesc::Box => x + 0.5,
+                    FilterDesc::Tent { radius } => {
+                        let t = x / radius as f64;
+                        match t < 0.0 {
+                            true => 0.5 * (1.0 + t).powi(2),
+                            false => 1.0 - 0.5 * (1.0 - t).powi(2),
+                        }
+                    }
+                    FilterDesc::Gaussian { stddev, radius } => {
+                        let s = std::f64::consts::SQRT_2 * stddev as f64;
+                        let e = erf((radius as f64 / s) as f32) as f64;
+                        (erf((x / s) as f32) as f64 + e) / (2.0 * e)
+                    }
+                };
+                f.clamp(0.0, 1.0)
+            };
+            let reach = match filter {
+                FilterDesc::Box => 0.5,
+                FilterDesc::Tent { radius } | FilterDesc::Gaussian { radius, .. } => radius,
+            };
             let c = Camera {
-                filter: FilterDesc::Gaussian { stddev, radius },
+                filter,
                 ..Camera::new(
                     &CameraDesc {
                         to_world: glam::Mat4::IDENTITY,
@@ -306,11 +338,8 @@ mod tests {
                 .map(|_| c.filter_offset(&mut rng))
                 .map(|o| (o.x as f64, o.y as f64))
                 .unzip();
-            let s = std::f64::consts::SQRT_2 * stddev as f64;
-            let e = erf((radius as f64 / s) as f32) as f64;
-            let cdf = |x: f64| ((erf((x / s) as f32) as f64 + e) / (2.0 * e)).clamp(0.0, 1.0);
             for v in [&mut xs, &mut ys] {
-                assert!(v.iter().all(|x| x.abs() <= radius as f64));
+                assert!(v.iter().all(|x| x.abs() <= reach as f64), "{filter:?}");
                 v.sort_by(f64::total_cmp);
                 let d = v
                     .iter()
@@ -322,10 +351,7 @@ mod tests {
                             .max(((i + 1) as f64 / n as f64 - f).abs())
                     })
                     .fold(0.0, f64::max);
-                assert!(
-                    d < 1.628 / (n as f64).sqrt(),
-                    "sd {stddev} radius {radius}: D = {d}"
-                );
+                assert!(d < 1.628 / (n as f64).sqrt(), "{filter:?}: D = {d}");
             }
         }
     }
