@@ -166,4 +166,38 @@ mod tests {
             !compare_regions((&constant(1.0), &zero), (&constant(1.01), &zero), 2, 0.01).passed()
         );
     }
+
+    /// z by hand on a 5x3 image in regions of 2: 3 x 2 regions (the last column and row of
+    /// regions clipped to one pixel), 18 tests. Variance of the mean 0.01 per pixel.
+    #[test]
+    fn region_comparison_by_hand() {
+        let filled = |v: f64| {
+            let mut i = Image::new(5, 3);
+            i.data.iter_mut().for_each(|p| *p = [v; 3]);
+            i
+        };
+        let (a, var) = (filled(1.0), filled(0.01));
+        // A 2x2 region: mean difference 0.2 / 4, variance (4 * 0.01 * 2) / 16.
+        let mut b = filled(1.0);
+        b.data[0][2] = 1.2;
+        let r = compare_regions((&a, &var), (&b, &var), 2, 0.01);
+        assert_eq!((r.tests, r.worst), (18, (0, 0, 2)));
+        assert!((r.max_abs_z - 0.05 / 0.005f64.sqrt()).abs() < 1e-9, "{r:?}");
+        // Sidak: 1 - 0.99^(1/18) = 5.582e-4, two-sided: z = 3.45115.
+        assert!((r.critical_z - 3.451153).abs() < 1e-5, "{r:?}");
+        assert!(r.passed());
+        // The clipped corner region, pixel (4, 2) alone: 0.5 / sqrt(0.02) = 3.5355.
+        b.data[2 * 5 + 4][1] = 1.5;
+        let r = compare_regions((&a, &var), (&b, &var), 2, 0.01);
+        assert_eq!(r.worst, (2, 1, 1));
+        assert!((r.max_abs_z - 0.5 / 0.02f64.sqrt()).abs() < 1e-9, "{r:?}");
+        assert!(!r.passed());
+        // At the critical value itself the test rejects (p = alpha).
+        let edge = RegionComparison {
+            max_abs_z: 2.0,
+            critical_z: 2.0,
+            ..r
+        };
+        assert!(!edge.passed());
+    }
 }
