@@ -177,6 +177,9 @@ mod tests {
             i
         };
         let (a, var) = (filled(1.0), filled(0.01));
+        // Ties name the first region and channel.
+        let r = compare_regions((&a, &var), (&a, &var), 2, 0.01);
+        assert_eq!((r.max_abs_z, r.worst), (0.0, (0, 0, 0)));
         // A 2x2 region: mean difference 0.2 / 4, variance (4 * 0.01 * 2) / 16.
         let mut b = filled(1.0);
         b.data[0][2] = 1.2;
@@ -199,5 +202,15 @@ mod tests {
             ..r
         };
         assert!(!edge.passed());
+        // Without noise, region means must agree to 1e-6 relative: in a region of 4 pixels
+        // of 1000, a pixel off by 2e-3 moves the mean 5e-7 relative, one off by 8e-3, 2e-6.
+        let zero = filled(0.0);
+        let (a, mut b) = (filled(1000.0), filled(1000.0));
+        b.data[1][0] += 2e-3;
+        let r = compare_regions((&a, &zero), (&b, &zero), 2, 0.01);
+        assert!(r.passed() && r.max_abs_z == 0.0, "{r:?}");
+        b.data[1][0] += 6e-3;
+        let r = compare_regions((&a, &zero), (&b, &zero), 2, 0.01);
+        assert!(!r.passed() && r.worst == (0, 0, 0), "{r:?}");
     }
 }
