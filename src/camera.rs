@@ -278,8 +278,7 @@ mod tests {
     /// Kolmogorov-Smirnov test of every filter's offsets against the filter's CDF per axis
     /// (box: uniform on [-1/2, 1/2]; tent: triangular on [-r, r]; Gaussian: truncated to
     /// the radius), at alpha = 0.01 (critical D = 1.628 / sqrt(n)), n = 20000, for wide and
-    /// narrow radii. A Gaussian radius of 0.01 sd took minutes per pixel when the offsets
-    /// were drawn by rejection.
+    /// narrow radii (a Gaussian radius far below its sd must not need rejection).
     #[test]
     fn filter_offsets_follow_the_filter() {
         use crate::sampling::erf::erf;

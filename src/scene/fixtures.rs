@@ -1,6 +1,7 @@
 //! Scenes built in code for tests and benchmarks, where a closed form is known.
 
 use super::desc::*;
+use super::mesh::TriMesh;
 use crate::math::look_at;
 use glam::{Mat4, Vec3};
 use std::path::PathBuf;
@@ -43,15 +44,40 @@ pub fn mesh(
     bsdf: BsdfDesc,
     radiance: Option<Rgb>,
 ) -> ShapeDesc {
+    let m = TriMesh {
+        positions,
+        normals: None,
+        indices,
+    };
+    tri_mesh(m, bsdf, radiance, "<fixture>")
+}
+
+/// A shape of the triangle mesh `m` (with its vertex normals, if any), emitting `radiance`
+/// if given.
+pub fn tri_mesh(m: TriMesh, bsdf: BsdfDesc, radiance: Option<Rgb>, origin: &str) -> ShapeDesc {
     ShapeDesc {
         geometry: ShapeGeometry::Mesh {
-            positions,
-            normals: None,
-            indices,
+            positions: m.positions,
+            normals: m.normals,
+            indices: m.indices,
         },
         bsdf,
         emitter: radiance.map(|radiance| AreaEmitterDesc { radiance }),
-        origin: "<fixture>".into(),
+        origin: origin.into(),
+    }
+}
+
+/// A sphere shape, emitting `radiance` if given.
+pub fn sphere(center: Vec3, radius: f32, bsdf: BsdfDesc, radiance: Option<Rgb>) -> ShapeDesc {
+    ShapeDesc {
+        geometry: ShapeGeometry::Sphere {
+            center,
+            radius,
+            flip_normals: false,
+        },
+        bsdf,
+        emitter: radiance.map(|radiance| AreaEmitterDesc { radiance }),
+        origin: "<fixture sphere>".into(),
     }
 }
 
@@ -114,18 +140,7 @@ pub fn triangle_over_floor(
 
 /// A spherical light of the given radiance over the floor.
 pub fn sphere_light(center: Vec3, radius: f32, radiance: f32) -> ShapeDesc {
-    ShapeDesc {
-        geometry: ShapeGeometry::Sphere {
-            center,
-            radius,
-            flip_normals: false,
-        },
-        bsdf: diffuse(0.0),
-        emitter: Some(AreaEmitterDesc {
-            radiance: Rgb::splat(radiance),
-        }),
-        origin: "<fixture sphere>".into(),
-    }
+    sphere(center, radius, diffuse(0.0), Some(Rgb::splat(radiance)))
 }
 
 /// A closed cube [-1,1]^3 whose inward-facing faces are diffuse (albedo `a`) and emit L = 1.

@@ -8,6 +8,7 @@
 //! seeds cover what it claims to test.
 
 use super::desc::*;
+use super::fixtures::{diffuse, sphere, tri_mesh};
 use super::mesh::{cube, load_obj, TriMesh};
 use crate::math::look_at;
 use crate::rng::Rng;
@@ -262,32 +263,6 @@ impl Gen {
     }
 }
 
-fn shape(m: TriMesh, bsdf: BsdfDesc, emitter: Option<Rgb>, origin: &str) -> ShapeDesc {
-    ShapeDesc {
-        geometry: ShapeGeometry::Mesh {
-            positions: m.positions,
-            normals: m.normals,
-            indices: m.indices,
-        },
-        bsdf,
-        emitter: emitter.map(|radiance| AreaEmitterDesc { radiance }),
-        origin: origin.into(),
-    }
-}
-
-fn sphere(center: Vec3, radius: f32, bsdf: BsdfDesc, emitter: Option<Rgb>) -> ShapeDesc {
-    ShapeDesc {
-        geometry: ShapeGeometry::Sphere {
-            center,
-            radius,
-            flip_normals: false,
-        },
-        bsdf,
-        emitter: emitter.map(|radiance| AreaEmitterDesc { radiance }),
-        origin: "<random sphere>".into(),
-    }
-}
-
 /// The scene of `seed`. Its OBJ files are written under `dir`.
 pub fn random_scene(seed: u64, dir: &Path) -> RandomScene {
     let dir = dir.join(format!("scene{seed}"));
@@ -314,7 +289,7 @@ pub fn random_scene(seed: u64, dir: &Path) -> RandomScene {
             m
         }
     };
-    shapes.push(shape(floor, bsdf, None, "<random floor>"));
+    shapes.push(tri_mesh(floor, bsdf, None, "<random floor>"));
 
     for _ in 0..1 + g.below(4) {
         let (bsdf, name) = g.material();
@@ -325,17 +300,17 @@ pub fn random_scene(seed: u64, dir: &Path) -> RandomScene {
             0 => {
                 f.smooth_receivers += 1;
                 let m = g.uv_sphere(c, r);
-                shape(m, bsdf, None, "<random smooth sphere>")
+                tri_mesh(m, bsdf, None, "<random smooth sphere>")
             }
             1 => sphere(c, r, bsdf, None),
             2 => {
                 let mut m = cube();
                 m.transform(&(Mat4::from_translation(c) * Mat4::from_scale(Vec3::splat(r))));
-                shape(m, bsdf, None, "<random cube>")
+                tri_mesh(m, bsdf, None, "<random cube>")
             }
             _ => {
                 let v = [g.unit(), g.unit(), g.unit()].map(|d| c + 2.0 * r * d);
-                shape(
+                tri_mesh(
                     TriMesh {
                         positions: v.to_vec(),
                         normals: None,
@@ -361,7 +336,7 @@ pub fn random_scene(seed: u64, dir: &Path) -> RandomScene {
         // Emitters reflect as well, now and then.
         let bsdf = match g.chance(0.3) {
             true => g.material().0,
-            false => black(),
+            false => diffuse(0.0),
         };
         if g.chance(0.3) {
             f.lights.push("sphere");
@@ -383,17 +358,15 @@ pub fn random_scene(seed: u64, dir: &Path) -> RandomScene {
         f.lights.push(if n > 8 { "mesh-big" } else { "mesh" });
         if g.chance(0.3) {
             f.lights.push("mesh-smooth");
-            let ng = normal;
-            let centre = c;
             m.normals = Some(
                 m.positions
                     .iter()
-                    .map(|&p| (ng + 0.5 * (p - centre)).normalize())
+                    .map(|&p| (normal + 0.5 * (p - c)).normalize())
                     .collect(),
             );
             m = g.through_obj(&m);
         }
-        shapes.push(shape(m, bsdf, Some(radiance), "<random light>"));
+        shapes.push(tri_mesh(m, bsdf, Some(radiance), "<random light>"));
     }
     let mut point_lights = Vec::new();
     if g.chance(0.12) {
@@ -463,10 +436,4 @@ pub fn random_scene(seed: u64, dir: &Path) -> RandomScene {
         warnings: vec![],
     };
     RandomScene { desc, features: f }
-}
-
-fn black() -> BsdfDesc {
-    BsdfDesc::Diffuse {
-        reflectance: Rgb::ZERO,
-    }
 }
