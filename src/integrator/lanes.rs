@@ -267,8 +267,8 @@ impl Direct<'_> {
     /// `camera_hits`'s loop for hits that all lie on one shape (most pixels' eight samples):
     /// its row read once for all lanes. False, with `h` untouched, for a material the lanes
     /// do not cover. It spells out the loop's material match and cover steps for all lanes
-    /// at once: helpers shared with the loop, per lane or per lane mask, cost the Cornell box
-    /// 0.8-2.1 % more instructions (callgrind).
+    /// at once: helpers shared with the loop, per lane or per lane mask, cost measurably more
+    /// instructions on the bundled scenes.
     #[inline(always)]
     fn fill_one_shape(&self, shape: &LaneShape, rays: &RayPacket, h: &mut CameraHits) -> bool {
         let camera = &h.camera;
