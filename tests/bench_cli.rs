@@ -31,6 +31,8 @@ fn bench_writes_every_section() {
             "10",
             "--sweep-spp",
             "4",
+            "--max-load-emitters",
+            "1000",
         ])
         .arg("--out")
         .arg(&out));
@@ -54,6 +56,7 @@ fn bench_writes_every_section() {
         "machine limit: 2 independent 1-thread renders",
         "machine: ",
         "cbox.xml: 16x16",
+        "scene loading as the emitter count grows",
     ] {
         assert!(
             stdout.contains(printed),
@@ -124,6 +127,9 @@ fn bench_writes_every_section() {
     assert_eq!(sections["scaling_emitters"], 4, "{sections:?}");
     assert_eq!(sections["emitter_choice"], 4, "{sections:?}");
     assert_eq!(sections["peak_memory"], 1, "{sections:?}");
+    // Reading and building the scene of 1,000 emitters.
+    assert_eq!(sections["load_xml"], 1, "{sections:?}");
+    assert_eq!(sections["load_build"], 1, "{sections:?}");
     // The CPU the numbers were measured on, named.
     assert_eq!(sections["machine"], 1, "{sections:?}");
     let _ = std::fs::remove_dir_all(&dir);

@@ -4,9 +4,11 @@
 //! own scaling (`throughput`, `copies`); the ray-tracing limit for the same ray mix and the
 //! share of render time spent outside traversal, on one thread and on the most threads
 //! (`ray_limit_section` here, measured by `raylimit`); per-sample cost as the triangle and
-//! emitter counts grow (`sweeps`, over the scenes of `scaling`); peak memory.
+//! emitter counts grow (`sweeps`, over the scenes of `scaling`); scene loading as the emitter
+//! count grows (`load`); peak memory.
 
 mod copies;
+mod load;
 mod raylimit;
 pub(crate) mod scaling;
 mod sweeps;
@@ -52,6 +54,10 @@ pub struct BenchArgs {
     /// Largest emitter count of the emitter-scaling sweep (1, 10, ... up to this).
     #[arg(long, default_value_t = 10_000)]
     pub max_emitters: usize,
+    /// Largest emitter count of the scene-loading sweep (1e3, 1e4, ... up to this; 0 leaves
+    /// the sweep out). A million emitters is a 190 MB XML file and about 3 GB of memory.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub max_load_emitters: usize,
     /// Output CSV.
     #[arg(long, default_value = "reports/bench/bench.csv")]
     pub out: PathBuf,
@@ -169,6 +175,8 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             unit: "bytes",
         });
     }
+    // After the peak memory, which is the renders' and not the million-emitter file's.
+    load::section(a, &mut rows)?;
     crate::output::write_atomic(&a.out, |tmp| {
         let mut w = csv::Writer::from_path(tmp).map_err(|e| format!("{}: {e}", a.out.display()))?;
         for r in &rows {

@@ -83,7 +83,26 @@ enum Prim {
     Sphere(Vec3, f32),
 }
 
+/// A zero-area triangle is left out of the BVH, since no ray can hit it.
+fn hittable([a, b, c]: [Vec3; 3]) -> bool {
+    (b - a).cross(c - a).length_squared() != 0.0
+}
+
 impl Accel {
+    /// The primitives `build_where(shapes, keep)` holds, counted without building it.
+    pub fn primitive_count_where(shapes: &[Shape], keep: impl Fn(&Shape) -> bool) -> usize {
+        shapes
+            .iter()
+            .filter(|s| keep(s))
+            .map(|s| match &s.kind {
+                ShapeKind::Mesh(m) => (0..m.indices.len())
+                    .filter(|&t| hittable(m.vertices(t)))
+                    .count(),
+                ShapeKind::Sphere(_) => 1,
+            })
+            .sum()
+    }
+
     /// Builds over all shapes; zero-area triangles are left out since no ray can hit them.
     pub fn build(shapes: &[Shape]) -> Accel {
         Accel::build_where(shapes, |_| true)
@@ -108,7 +127,7 @@ impl Accel {
                     for ti in 0..m.indices.len() {
                         refs.push((si as u32, ti as u32));
                         let [a, b, c] = m.vertices(ti);
-                        if (b - a).cross(c - a).length_squared() == 0.0 {
+                        if !hittable([a, b, c]) {
                             continue;
                         }
                         prims.push((Prim::Tri([a, b, c]), refs.len() as u32 - 1));
@@ -464,6 +483,36 @@ mod tests {
             hits > rays / 4,
             "only {hits} hits: the test exercises too few hits"
         );
+    }
+
+    /// The count the emitter pre-test decides on before building must be the built count:
+    /// zero-area triangles left out, spheres counted once, unselected shapes not at all.
+    #[test]
+    fn primitive_count_where_matches_the_built_structure() {
+        let mut front = quad_grid(3, 0.5);
+        if let ShapeKind::Mesh(m) = &mut front.kind {
+            let mut indices = vec![[0, 0, 1], [2, 3, 3]];
+            indices.extend_from_slice(&m.indices);
+            *m = Mesh::new(m.positions.clone(), None, indices);
+        }
+        front.emitter = Some(0);
+        let sphere = Shape {
+            kind: ShapeKind::Sphere(Sphere {
+                center: Vec3::ONE,
+                radius: 0.5,
+                flip_normals: false,
+            }),
+            material: 0,
+            emitter: Some(1),
+        };
+        let shapes = vec![quad_grid(4, 0.0), front, sphere];
+        let keeps: [fn(&Shape) -> bool; 3] = [|_| true, |s| s.emitter.is_some(), |_| false];
+        let counts = keeps.map(|keep| {
+            let n = Accel::primitive_count_where(&shapes, keep);
+            assert_eq!(n, Accel::build_where(&shapes, keep).primitive_count());
+            n
+        });
+        assert_eq!(counts, [32 + 18 + 1, 18 + 1, 0]);
     }
 
     /// A ray told to skip the triangle it would hit passes through to the one behind: the id

@@ -56,9 +56,10 @@ fn emitter_pretest(shapes: &[Shape], emitters: &[Emitter], accel: &Accel) -> Opt
             Emitter::Point(_) => 0.0,
         })
         .sum();
-    (4.0 * emitter_area <= all_area)
-        .then(|| Accel::build_where(shapes, |s| s.emitter.is_some()))
-        .filter(|e| 2 * e.primitive_count() <= accel.primitive_count())
+    let is_emitter = |s: &Shape| s.emitter.is_some();
+    (4.0 * emitter_area <= all_area
+        && 2 * Accel::primitive_count_where(shapes, is_emitter) <= accel.primitive_count())
+    .then(|| Accel::build_where(shapes, is_emitter))
 }
 
 fn err(origin: &str, message: impl Into<String>) -> BuildError {

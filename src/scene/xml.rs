@@ -9,38 +9,104 @@ use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::rc::Rc;
 
+/// A string of the scene document: a range of the shared source text, or (after `$name`
+/// substitution or entity expansion) a string of its own. Ranges cost no allocation, which
+/// is what lets a scene of a million elements load in seconds.
+#[derive(Clone)]
+pub struct Text {
+    src: Rc<str>,
+    start: u32,
+    end: u32,
+}
+
+impl Text {
+    fn owned(s: &str) -> Text {
+        Text {
+            src: Rc::from(s),
+            start: 0,
+            end: s.len() as u32,
+        }
+    }
+
+    pub fn as_str(&self) -> &str {
+        &self.src[self.start as usize..self.end as usize]
+    }
+}
+
+impl std::ops::Deref for Text {
+    type Target = str;
+    fn deref(&self) -> &str {
+        self.as_str()
+    }
+}
+
+impl PartialEq<&str> for Text {
+    fn eq(&self, other: &&str) -> bool {
+        self.as_str() == *other
+    }
+}
+
+impl std::fmt::Display for Text {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::fmt::Debug for Text {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:?}", self.as_str())
+    }
+}
+
+#[derive(Clone, Debug)]
+struct Attr {
+    name: Text,
+    /// After `$name` substitution.
+    value: Text,
+    /// As written, for messages.
+    raw: Text,
+}
+
 #[derive(Clone, Debug)]
 pub struct Element {
-    pub tag: String,
-    /// Attribute values after `$name` substitution.
-    pub attrs: Vec<(String, String)>,
+    pub tag: Text,
+    attrs: Vec<Attr>,
     pub children: Vec<Element>,
     pub line: u32,
-    /// Opening tag with the attributes as written, for messages.
-    pub display: String,
     pub file: Rc<Path>,
 }
 
 impl Element {
+    /// The value of attribute `name`, after `$name` substitution.
     pub fn attr(&self, name: &str) -> Option<&str> {
         self.attrs
             .iter()
-            .find(|(k, _)| k == name)
-            .map(|(_, v)| v.as_str())
+            .find(|a| a.name.as_str() == name)
+            .map(|a| a.value.as_str())
+    }
+
+    /// The opening tag with its attributes as written (each clipped), for messages.
+    pub fn display(&self) -> String {
+        let mut d = format!("<{}", clip(&self.tag));
+        for a in &self.attrs {
+            d.push_str(&format!(" {}=\"{}\"", clip(&a.name), clip(&a.raw)));
+        }
+        d.push('>');
+        d
     }
 
     pub fn err(&self, message: impl Into<String>) -> SceneError {
         SceneError {
             file: self.file.to_path_buf(),
             line: Some(self.line),
-            element: Some(self.display.clone()),
+            element: Some(self.display()),
             message: message.into(),
         }
     }
 
     /// "file:line <tag ...>", the form used in warnings and `ShapeDesc::origin`.
     pub fn origin(&self) -> String {
-        format!("{}:{} {}", self.file.display(), self.line, self.display)
+        format!("{}:{} {}", self.file.display(), self.line, self.display())
     }
 
     pub fn required_attr(&self, name: &str) -> Result<&str, SceneError> {
@@ -51,7 +117,7 @@ impl Element {
     /// Unknown attributes are almost always typos (`vaule=`), which would otherwise silently
     /// fall back to a default.
     pub fn check_attrs(&self, allowed: &[&str]) -> Result<(), SceneError> {
-        for (k, _) in &self.attrs {
+        for Attr { name: k, .. } in &self.attrs {
             if !allowed.contains(&k.as_str()) {
                 return Err(self.err(format!(
                     "unexpected attribute '{k}'; expected one of: {}",
@@ -199,22 +265,44 @@ struct Params {
     used: std::cell::RefCell<HashSet<String>>,
 }
 
-/// Line numbers of byte offsets, from a table of line starts: one binary search per element
-/// (roxmltree's `text_pos_at` scans from the document's start each time, which made loading
-/// quadratic in the element count).
-struct Lines(Vec<usize>);
+/// Line numbers of byte offsets, from a table of line starts (roxmltree's `text_pos_at` scans
+/// from the document's start each time, which made loading quadratic in the element count).
+/// Elements are converted in document order, so the line of the previous one is where the
+/// search starts: a step or two instead of a binary search of cache misses per element.
+struct Lines {
+    starts: Vec<usize>,
+    /// Index in `starts` of the line last returned.
+    last: std::cell::Cell<usize>,
+}
 
 impl Lines {
     fn new(text: &str) -> Self {
         let starts = std::iter::once(0)
             .chain(text.match_indices('\n').map(|(i, _)| i + 1))
             .collect();
-        Lines(starts)
+        Lines {
+            starts,
+            last: Default::default(),
+        }
     }
 
     /// 1-based line of byte offset `pos`.
     fn of(&self, pos: usize) -> u32 {
-        self.0.partition_point(|&s| s <= pos) as u32
+        let s = &self.starts;
+        let mut i = self.last.get();
+        if s[i] <= pos {
+            while i + 1 < s.len() && s[i + 1] <= pos {
+                i += 1;
+                if i - self.last.get() > 16 {
+                    i += s[i..].partition_point(|&x| x <= pos) - 1;
+                    break;
+                }
+            }
+        } else {
+            i = s.partition_point(|&x| x <= pos) - 1;
+        }
+        self.last.set(i);
+        i as u32 + 1
     }
 }
 
@@ -237,7 +325,17 @@ pub fn parse_document(
         allow_dtd: true,
         ..Default::default()
     };
-    let doc = roxmltree::Document::parse_with_options(xml, options).map_err(|e| SceneError {
+    if u32::try_from(xml.len()).is_err() {
+        return Err(SceneError::new(
+            file,
+            format!(
+                "document is {} bytes; at most 4 GiB are accepted",
+                xml.len()
+            ),
+        ));
+    }
+    let src: Rc<str> = Rc::from(xml);
+    let doc = roxmltree::Document::parse_with_options(&src, options).map_err(|e| SceneError {
         file: file.to_path_buf(),
         line: Some(e.pos().row),
         element: None,
@@ -246,6 +344,7 @@ pub fn parse_document(
     let cx = Context {
         file: Rc::from(file),
         lines: Lines::new(xml),
+        src: src.clone(),
     };
     let root = doc.root_element();
     check_depth(&cx, root)?;
@@ -304,6 +403,27 @@ pub fn parse_document(
 struct Context {
     file: Rc<Path>,
     lines: Lines,
+    /// The document, which `Text`s share.
+    src: Rc<str>,
+}
+
+impl Context {
+    /// `s` as a range of the document when it is one (names, and values without entities),
+    /// else as a string of its own.
+    fn text(&self, s: &str) -> Text {
+        let base = self.src.as_ptr() as usize;
+        let at = s.as_ptr() as usize;
+        if at >= base && at + s.len() <= base + self.src.len() {
+            let start = (at - base) as u32;
+            Text {
+                src: self.src.clone(),
+                start,
+                end: start + s.len() as u32,
+            }
+        } else {
+            Text::owned(s)
+        }
+    }
 }
 
 /// Refuses nesting deeper than [`MAX_DEPTH`], walking the tree without recursion.
@@ -332,38 +452,36 @@ fn convert(
     node: roxmltree::Node,
     params: Option<&Params>,
 ) -> Result<Element, SceneError> {
-    let tag = node.tag_name().name().to_string();
-    let line = cx.lines.of(node.range().start);
-    let mut display = String::with_capacity(64);
-    display.push('<');
-    display.push_str(&clip(&tag));
-    for a in node.attributes() {
-        display.push(' ');
-        display.push_str(&clip(a.name()));
-        display.push_str("=\"");
-        display.push_str(&clip(a.value()));
-        display.push('"');
-    }
-    display.push('>');
     let mut elem = Element {
-        tag,
+        tag: cx.text(node.tag_name().name()),
         attrs: Vec::with_capacity(node.attributes().len()),
-        children: Vec::with_capacity(node.children().filter(|n| n.is_element()).count()),
-        line,
-        display,
+        children: Vec::new(),
+        line: cx.lines.of(node.range().start),
         file: cx.file.clone(),
     };
-    // <default> values were substituted when the parameter table was built.
-    let params = params.filter(|_| elem.tag != "default");
     for a in node.attributes() {
-        let value = match params {
-            Some(p) => substitute(a.value(), p).map_err(|m| elem.err(m))?,
-            None => a.value().to_string(),
-        };
-        elem.attrs.push((a.name().to_string(), value));
+        let raw = cx.text(a.value());
+        elem.attrs.push(Attr {
+            name: cx.text(a.name()),
+            value: raw.clone(),
+            raw,
+        });
     }
-    for child in node.children().filter(|n| n.is_element()) {
-        elem.children.push(convert(cx, child, params)?);
+    // <default> values were substituted when the parameter table was built.
+    if let Some(p) = params.filter(|_| elem.tag != "default") {
+        for i in 0..elem.attrs.len() {
+            if elem.attrs[i].raw.contains('$') {
+                let value = substitute(&elem.attrs[i].raw, p).map_err(|m| elem.err(m))?;
+                elem.attrs[i].value = Text::owned(&value);
+            }
+        }
+    }
+    let n = node.children().filter(|n| n.is_element()).count();
+    if n > 0 {
+        elem.children.reserve_exact(n);
+        for child in node.children().filter(|n| n.is_element()) {
+            elem.children.push(convert(cx, child, params)?);
+        }
     }
     Ok(elem)
 }
@@ -443,6 +561,26 @@ mod tests {
         assert!(e.contains("shape"), "{e}");
     }
 
+    /// The line of an offset is 1 + the newlines before it, whether offsets come in order
+    /// (short and long steps forward) or not.
+    #[test]
+    fn lines_of_offsets_in_any_order() {
+        let text: String = (0..500)
+            .map(|i| "x".repeat(i % 7) + "\n")
+            .collect::<String>()
+            + "tail";
+        let lines = Lines::new(&text);
+        let naive = |pos: usize| text[..pos].matches('\n').count() as u32 + 1;
+        let forward: Vec<usize> = (0..text.len()).step_by(3).collect();
+        let mut rng = crate::rng::Rng::new(7, 0);
+        let random: Vec<usize> = (0..2000)
+            .map(|_| (rng.next_f32() * text.len() as f32) as usize % text.len())
+            .collect();
+        for pos in forward.iter().chain(&random).chain(&[0, text.len() - 1]) {
+            assert_eq!(lines.of(*pos), naive(*pos), "offset {pos}");
+        }
+    }
+
     #[test]
     fn elements_remember_lines_and_attributes() {
         let root = parse(
@@ -452,7 +590,7 @@ mod tests {
         .unwrap();
         let b = &root.children[0];
         assert_eq!(b.line, 3);
-        assert_eq!(b.display, "<bsdf type=\"diffuse\" id=\"a\">");
+        assert_eq!(b.display(), "<bsdf type=\"diffuse\" id=\"a\">");
         assert!(b.check_attrs(&["type", "id"]).is_ok());
         let e = b.check_attrs(&["type"]).unwrap_err().to_string();
         assert!(e.contains("unexpected attribute 'id'"), "{e}");
