@@ -120,3 +120,6 @@ impl Emitter {
         }
     }
 }
+
+#[cfg(test)]
+mod tests;

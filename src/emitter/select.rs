@@ -116,6 +116,21 @@ mod tests {
         ]
     }
 
+    /// The count the lane tables check against their own, for both rules; none chooses
+    /// nothing.
+    #[test]
+    fn len_counts_the_emitters() {
+        for mode in [EmitterSelection::Uniform, EmitterSelection::Power] {
+            let s = EmitterSelector::new(&emitters(), mode);
+            assert_eq!((s.len(), s.is_empty()), (5, false));
+            let one = EmitterSelector::new(&emitters()[..1], mode);
+            assert_eq!((one.len(), one.is_empty()), (1, false));
+            let none = EmitterSelector::new(&[], mode);
+            assert_eq!((none.len(), none.is_empty()), (0, true));
+            assert!(none.sample(0.5).is_none());
+        }
+    }
+
     #[test]
     fn power_pmf_is_proportional_to_power() {
         let e = emitters();
