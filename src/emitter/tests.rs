@@ -168,11 +168,17 @@ fn sphere_light_uses_its_cone_exactly_when_seen_from_outside() {
     const C: Vec3 = Vec3::new(0.5, -1.0, 2.0);
     let mut rng = crate::rng::Rng::new(3, 0);
     let outside = ball(false);
-    for ref_p in [C + Vec3::new(2.0, 0.0, 0.0), C + Vec3::new(0.0, -3.0, 4.0)] {
+    // At 1.2 radii the point is outside by far more than the margin of 1e-5 in dc^2 / r^2.
+    for ref_p in [
+        C + Vec3::new(2.0, 0.0, 0.0),
+        C + Vec3::new(0.0, -3.0, 4.0),
+        C + Vec3::new(0.0, 1.2, 0.0),
+    ] {
         let d2 = (ref_p - C).length_squared();
         let one_minus = 1.0 - (1.0 - 1.0 / d2).sqrt();
         let cos_max = 1.0 - one_minus;
-        for _ in 0..200 {
+        let (mut n, mut sum_cos) = (0, 0.0f64);
+        for _ in 0..2000 {
             let u = Vec2::new(rng.next_f32(), rng.next_f32());
             let Some(ls) = outside.emitters[0].sample(
                 &outside.shapes,
@@ -183,6 +189,8 @@ fn sphere_light_uses_its_cone_exactly_when_seen_from_outside() {
             ) else {
                 continue;
             };
+            n += 1;
+            sum_cos += ls.wi.dot((C - ref_p).normalize()) as f64;
             let want = 1.0 / (2.0 * PI * one_minus);
             assert!(
                 (ls.pdf / want - 1.0).abs() < 1e-4,
@@ -203,6 +211,16 @@ fn sphere_light_uses_its_cone_exactly_when_seen_from_outside() {
             );
             assert!((pdf / want - 1.0).abs() < 1e-4, "{pdf} against {want}");
         }
+        // Every direction in the cone meets the sphere's near side, which faces the point.
+        assert!(n >= 1990, "{ref_p}: only {n} of 2000 cone samples");
+        // Uniform in the cone: cos theta uniform on [cos_max, 1], so its mean is off by more
+        // than 5 standard errors with probability 6e-7.
+        let (mean, want) = (sum_cos / n as f64, (1.0 + cos_max as f64) / 2.0);
+        let se = one_minus as f64 / 12f64.sqrt() / (n as f64).sqrt();
+        assert!(
+            (mean - want).abs() < 5.0 * se,
+            "{ref_p}: mean cos {mean} against {want}"
+        );
     }
     // Inside (lit where the normals point inwards), just outside the surface (within the
     // margin), and inward normals from outside: uniform points on the sphere, by area.
@@ -211,8 +229,8 @@ fn sphere_light_uses_its_cone_exactly_when_seen_from_outside() {
         (ball(true), C + Vec3::new(3.0, 0.0, 0.0)),
     ];
     for (s, ref_p) in &cases {
-        let mut n = 0;
-        for _ in 0..200 {
+        let (mut n, mut sum_cos) = (0, 0.0f64);
+        for _ in 0..2000 {
             let u = Vec2::new(rng.next_f32(), rng.next_f32());
             let Some(ls) =
                 s.emitters[0].sample(&s.shapes, *ref_p, 0.5, u, LightSampling::SolidAngle)
