@@ -411,3 +411,74 @@ fn mis_variance_is_the_named_heuristics_with_its_sample_counts() {
         }
     }
 }
+
+/// Paths only one technique can make, at sample counts 2 (light) and 3 (BSDF), so that each
+/// technique's division by its own count and each fallback matters: a mirror floor under a
+/// large emitting quad (every strategy sees L through the mirror; light sampling through its
+/// fallback to BSDF samples) and a point light over a diffuse floor (BSDF sampling through
+/// its fallback to light samples). Most strategies are exact here (zero variance: the value
+/// must be within 1e-6); one-sample MIS is z-tested (ALPHA, Sidak over all cases).
+#[test]
+fn delta_paths_at_sample_counts_two_and_three() {
+    use crate::scene::desc::{BsdfDesc, PointLightDesc};
+    let radiance = 3.0f32;
+    let mut mirror = fixtures::floor_probe(0.5, Vec3::ZERO, Vec3::new(0.0, -3.0, 3.0));
+    mirror.shapes[0].bsdf = BsdfDesc::Mirror;
+    // At z = 4, facing down: the mirrored camera ray, direction (0, 1, 1) / sqrt 2, meets it
+    // at y = 4.
+    let s = 10.0;
+    mirror.shapes.push(fixtures::mesh(
+        vec![
+            Vec3::new(-s, -s, 4.0),
+            Vec3::new(s, -s, 4.0),
+            Vec3::new(s, s, 4.0),
+            Vec3::new(-s, s, 4.0),
+        ],
+        vec![[0, 2, 1], [0, 3, 2]],
+        fixtures::diffuse(0.0),
+        Some(crate::math::Rgb::splat(radiance)),
+    ));
+    let albedo = 0.8f32;
+    let (pos, intensity) = (Vec3::new(0.5, -0.3, 1.5), 2.0f32);
+    let mut point = fixtures::floor_probe(albedo, Vec3::ZERO, Vec3::new(0.0, -3.0, 3.0));
+    point.point_lights.push(PointLightDesc {
+        position: pos,
+        intensity: crate::math::Rgb::splat(intensity),
+        origin: "<test>".into(),
+    });
+    let d2 = pos.length_squared() as f64;
+    let e_point = intensity as f64 * (pos.z as f64 / d2.sqrt()) / d2;
+    let cases = [
+        (Scene::build(mirror).unwrap(), radiance as f64),
+        (
+            Scene::build(point).unwrap(),
+            albedo as f64 / std::f64::consts::PI * e_point,
+        ),
+    ];
+    let strategies: Vec<Strategy> = all_strategies()
+        .into_iter()
+        .map(|s| Strategy {
+            emitter_samples: 2,
+            bsdf_samples: 3,
+            ..s
+        })
+        .collect();
+    let zc = z_critical(ALPHA, strategies.len() * cases.len());
+    for (scene, expected) in &cases {
+        for s in &strategies {
+            let out = render(scene, *s, &settings(4096, 5));
+            assert_eq!(out.non_finite_samples, 0);
+            let (z, mean) = image_z(&out, *expected);
+            assert!(
+                z.abs() < zc,
+                "{} on {}: {mean} vs {expected}, z = {z:.2} (critical {zc:.2})",
+                s.label(),
+                if scene.emitters[0].is_delta() {
+                    "the point light"
+                } else {
+                    "the mirror"
+                }
+            );
+        }
+    }
+}
