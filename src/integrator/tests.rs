@@ -426,15 +426,10 @@ fn delta_paths_at_sample_counts_two_and_three() {
     mirror.shapes[0].bsdf = BsdfDesc::Mirror;
     // At z = 4, facing down: the mirrored camera ray, direction (0, 1, 1) / sqrt 2, meets it
     // at y = 4.
-    let s = 10.0;
-    mirror.shapes.push(fixtures::mesh(
-        vec![
-            Vec3::new(-s, -s, 4.0),
-            Vec3::new(s, -s, 4.0),
-            Vec3::new(s, s, 4.0),
-            Vec3::new(-s, s, 4.0),
-        ],
-        vec![[0, 2, 1], [0, 3, 2]],
+    mirror.shapes.push(fixtures::square_z(
+        10.0,
+        4.0,
+        false,
         fixtures::diffuse(0.0),
         Some(crate::math::Rgb::splat(radiance)),
     ));

@@ -87,19 +87,29 @@ pub fn diffuse(a: f32) -> BsdfDesc {
     }
 }
 
-fn floor(albedo: f32) -> ShapeDesc {
-    let s = 50.0;
+/// The square [-half, half]^2 at height `z`, facing +z if `up`, else -z.
+pub fn square_z(half: f32, z: f32, up: bool, bsdf: BsdfDesc, radiance: Option<Rgb>) -> ShapeDesc {
+    let s = half;
+    let indices = if up {
+        vec![[0, 1, 2], [0, 2, 3]]
+    } else {
+        vec![[0, 2, 1], [0, 3, 2]]
+    };
     mesh(
         vec![
-            Vec3::new(-s, -s, 0.0),
-            Vec3::new(s, -s, 0.0),
-            Vec3::new(s, s, 0.0),
-            Vec3::new(-s, s, 0.0),
+            Vec3::new(-s, -s, z),
+            Vec3::new(s, -s, z),
+            Vec3::new(s, s, z),
+            Vec3::new(-s, s, z),
         ],
-        vec![[0, 1, 2], [0, 2, 3]],
-        diffuse(albedo),
-        None,
+        indices,
+        bsdf,
+        radiance,
     )
+}
+
+fn floor(albedo: f32) -> ShapeDesc {
+    square_z(50.0, 0.0, true, diffuse(albedo), None)
 }
 
 /// A large diffuse floor z = 0 (normal +z), seen by a one-pixel camera with a tiny field of

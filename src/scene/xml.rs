@@ -265,44 +265,22 @@ struct Params {
     used: std::cell::RefCell<HashSet<String>>,
 }
 
-/// Line numbers of byte offsets, from a table of line starts (roxmltree's `text_pos_at` scans
-/// from the document's start each time, which made loading quadratic in the element count).
-/// Elements are converted in document order, so the line of the previous one is where the
-/// search starts: a step or two instead of a binary search of cache misses per element.
-struct Lines {
-    starts: Vec<usize>,
-    /// Index in `starts` of the line last returned.
-    last: std::cell::Cell<usize>,
-}
+/// Line numbers of byte offsets, from a table of line starts: one binary search per element
+/// (roxmltree's `text_pos_at` scans from the document's start each time, which made loading
+/// quadratic in the element count).
+struct Lines(Vec<usize>);
 
 impl Lines {
     fn new(text: &str) -> Self {
         let starts = std::iter::once(0)
             .chain(text.match_indices('\n').map(|(i, _)| i + 1))
             .collect();
-        Lines {
-            starts,
-            last: Default::default(),
-        }
+        Lines(starts)
     }
 
     /// 1-based line of byte offset `pos`.
     fn of(&self, pos: usize) -> u32 {
-        let s = &self.starts;
-        let mut i = self.last.get();
-        if s[i] <= pos {
-            while i + 1 < s.len() && s[i + 1] <= pos {
-                i += 1;
-                if i - self.last.get() > 16 {
-                    i += s[i..].partition_point(|&x| x <= pos) - 1;
-                    break;
-                }
-            }
-        } else {
-            i = s.partition_point(|&x| x <= pos) - 1;
-        }
-        self.last.set(i);
-        i as u32 + 1
+        self.0.partition_point(|&s| s <= pos) as u32
     }
 }
 
