@@ -103,43 +103,7 @@ impl Direct<'_> {
             wi_local.set(i, wi);
             lambda_i[i] = lambda;
         }
-        let mut vis = VisibleX8::default();
-        for i in 0..LANES {
-            vis.y[i] = beckmann_visible_y(u[6][i]);
-        }
-        for i in 0..LANES {
-            let rc = h.rough_conductor(i);
-            let (cos_phi, sin_phi, tan_t) = rc.mf.beckmann_visible_azimuth(wi_local.get(i));
-            (vis.cos_phi[i], vis.sin_phi[i], vis.tan_t[i]) = (cos_phi, sin_phi, tan_t);
-        }
-        for i in 0..LANES {
-            let b = SlopeInversion::new(vis.tan_t[i], u[5][i]);
-            (vis.x[i], vis.lo[i], vis.hi[i], vis.done[i]) = (b.x, b.lo, b.hi, b.done);
-            (vis.target[i], vis.k[i]) = (b.target, b.k);
-        }
-        for _ in 0..SlopeInversion::FIXED_STEPS {
-            vis.step(false);
-        }
-        // Lanes without a covered hit hold garbage (NaN), which would bisect to the 64-step
-        // limit: their samples are dropped, so they take no more steps.
-        let short = |v: &VisibleX8, i: usize| !v.done[i] && h.covered >> i & 1 != 0;
-        // One more step in vector lanes, where any lane needs it.
-        let taken = if (0..LANES).any(|i| short(&vis, i)) {
-            #[cfg(test)]
-            crate::sampling::microfacet::ITERS
-                .with(|c| c.set(c.get() + (0..LANES).filter(|&i| short(&vis, i)).count() as u64));
-            vis.step(true);
-            SlopeInversion::FIXED_STEPS + 1
-        } else {
-            SlopeInversion::FIXED_STEPS
-        };
-        for i in 0..LANES {
-            if short(&vis, i) {
-                let mut b = vis.get(i);
-                b.slope.finish(taken);
-                vis.set(i, b);
-            }
-        }
+        let vis = VisibleX8::invert(|i| h.rough_conductor(i).mf, &wi_local, u, h.covered);
         for i in 0..LANES {
             let sp = h.camera.point(i);
             let rc = h.rough_conductor(i);
@@ -179,6 +143,54 @@ struct VisibleX8 {
 }
 
 impl VisibleX8 {
+    /// `Microfacet::beckmann_visible_begin` and the slope inversion for eight lanes: the
+    /// fixed steps and one more in vector lanes, then the scalar steps the lanes in `live`
+    /// still need. Lanes outside `live` stop after the vector steps (their samples are
+    /// dropped; garbage would bisect to the step limit).
+    #[inline(always)]
+    fn invert(
+        mf: impl Fn(usize) -> Microfacet,
+        wi: &V3x8,
+        u: &[[f32; LANES]; 7],
+        live: u32,
+    ) -> VisibleX8 {
+        let mut vis = VisibleX8::default();
+        for i in 0..LANES {
+            vis.y[i] = beckmann_visible_y(u[6][i]);
+        }
+        for i in 0..LANES {
+            let (cos_phi, sin_phi, tan_t) = mf(i).beckmann_visible_azimuth(wi.get(i));
+            (vis.cos_phi[i], vis.sin_phi[i], vis.tan_t[i]) = (cos_phi, sin_phi, tan_t);
+        }
+        for i in 0..LANES {
+            let b = SlopeInversion::new(vis.tan_t[i], u[5][i]);
+            (vis.x[i], vis.lo[i], vis.hi[i], vis.done[i]) = (b.x, b.lo, b.hi, b.done);
+            (vis.target[i], vis.k[i]) = (b.target, b.k);
+        }
+        for _ in 0..SlopeInversion::FIXED_STEPS {
+            vis.step(false);
+        }
+        let short = |v: &VisibleX8, i: usize| !v.done[i] && live >> i & 1 != 0;
+        // One more step in vector lanes, where any lane needs it.
+        let taken = if (0..LANES).any(|i| short(&vis, i)) {
+            #[cfg(test)]
+            crate::sampling::microfacet::ITERS
+                .with(|c| c.set(c.get() + (0..LANES).filter(|&i| short(&vis, i)).count() as u64));
+            vis.step(true);
+            SlopeInversion::FIXED_STEPS + 1
+        } else {
+            SlopeInversion::FIXED_STEPS
+        };
+        for i in 0..LANES {
+            if short(&vis, i) {
+                let mut b = vis.get(i);
+                b.slope.finish(taken);
+                vis.set(i, b);
+            }
+        }
+        vis
+    }
+
     /// One slope step in every lane. With `keep_converged`, lanes whose last step converged
     /// keep their point, as `SlopeInversion::finish` would leave them.
     #[inline(always)]
@@ -237,6 +249,63 @@ mod tests {
     use crate::scene::desc::StrategyKind;
     use crate::scene::Scene;
     use glam::Vec3;
+
+    /// The lanes' inversion is the scalar sampler's, bitwise, also for lanes that need
+    /// scalar steps after the vector ones (grazing incidence with u near 0, found by counting
+    /// the scalar steps), and whichever lanes are live.
+    #[test]
+    fn lane_inversion_is_the_scalar_one_for_slow_lanes() {
+        use super::{V3x8, VisibleX8};
+        use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
+        use glam::Vec2;
+        let mut cases = Vec::new();
+        let mut slow = 0;
+        for alpha in [0.05f32, 0.5] {
+            let mf = Microfacet::new(MicrofacetDistribution::Beckmann, alpha, alpha * 1.5);
+            for cos in [1e-7f32, 1e-6, 1e-5, 1e-3, 0.3, 1.0] {
+                for u5 in [
+                    0.0f32,
+                    1e-30,
+                    1e-10,
+                    1e-7,
+                    1e-5,
+                    0.3,
+                    0.99999,
+                    1.0 - f32::EPSILON,
+                ] {
+                    let wi = Vec3::new(0.6, 0.8, 0.0) * (1.0 - cos * cos).sqrt() + Vec3::Z * cos;
+                    let u = Vec2::new(u5, 0.37);
+                    ITERS.with(|c| c.set(0));
+                    let m = mf.sample_visible(wi, u);
+                    let steps = ITERS.with(|c| c.get()) as usize;
+                    slow += (steps > crate::sampling::microfacet::SlopeInversion::FIXED_STEPS + 1)
+                        as usize;
+                    cases.push((mf, wi, u, m));
+                }
+            }
+        }
+        assert!(slow >= 8, "only {slow} cases need scalar steps");
+        for (b, batch) in cases.chunks(LANES).enumerate() {
+            let lane = |i: usize| &batch[i % batch.len()];
+            let mut wi = V3x8::default();
+            let mut u = [[0.0f32; LANES]; 7];
+            for i in 0..LANES {
+                wi.set(i, lane(i).1);
+                (u[5][i], u[6][i]) = (lane(i).2.x, lane(i).2.y);
+            }
+            for live in [0xff, 0x55 << (b % 2)] {
+                let vis = VisibleX8::invert(|i| lane(i).0, &wi, &u, live);
+                for i in (0..LANES).filter(|i| live >> i & 1 != 0) {
+                    let (mf, _, _, want) = lane(i);
+                    let got = mf.beckmann_visible_end(&vis.get(i));
+                    assert_eq!(
+                        got.to_array().map(f32::to_bits),
+                        want.to_array().map(f32::to_bits)
+                    );
+                }
+            }
+        }
+    }
 
     /// Cost guard: in a batch of rough-conductor hits, lanes without a covered hit (rays
     /// that leave the scene) take no slope steps past the fixed ones. Their inversions are
