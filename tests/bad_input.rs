@@ -561,3 +561,25 @@ fn reflectance_above_one_is_warned_about() {
         "only the diffuse one: {err}"
     );
 }
+
+/// Output into a pipe nobody reads any more (`directlab chi2 --list | head -1` once head has
+/// exited): the process ends by SIGPIPE, as Unix tools do, without a panic message.
+#[test]
+fn a_closed_stdout_pipe_ends_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    let (reader, writer) = std::io::pipe().unwrap();
+    // Closed before the process starts, so its first write meets a closed pipe.
+    drop(reader);
+    let out = directlab()
+        .args(["chi2", "--list"])
+        .stdout(writer)
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.signal(), Some(SIGPIPE), "{:?}", out.status);
+}
+
+/// SIGPIPE's number on Linux and the BSDs.
+const SIGPIPE: i32 = 13;
