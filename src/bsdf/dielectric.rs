@@ -94,6 +94,14 @@ mod tests {
             };
             let sin = |w: Vec3| (w.x * w.x + w.y * w.y).sqrt();
             assert!((n_i * sin(wi) - n_t * sin(t.wo)).abs() < 1e-5);
+            // In the plane of incidence, on the far side of the normal (both directions
+            // point away from the surface): wo_xy = -(n_i / n_t) wi_xy.
+            let want = -(n_i / n_t) * wi.truncate();
+            assert!(
+                (t.wo.truncate() - want).length() < 1e-5,
+                "{} vs {want}",
+                t.wo
+            );
             let back = m.sample(t.wo, 0.999_999, Vec2::ZERO).unwrap();
             assert!((back.wo - wi).length() < 1e-4, "{} vs {wi}", back.wo);
             assert!((t.weight.x * back.weight.x - 1.0).abs() < 1e-5);

@@ -248,3 +248,32 @@ fn every_registered_bsdf_passes_the_white_furnace() {
         report.join("; ")
     );
 }
+
+/// At exactly grazing incidence (wi.z = +0 or -0) every registered material, one-sided or
+/// two-sided, reflects and transmits nothing: eval and pdf are 0 towards any direction, and
+/// a sample is refused or carries no weight. Which side a two-sided material takes wi.z = 0
+/// for must not matter.
+#[test]
+fn every_registered_bsdf_is_black_at_exactly_grazing_incidence() {
+    let mut rng = Rng::new(5, 1);
+    for ty in SUPPORTED_BSDFS {
+        for c in cases(ty) {
+            let mut m = material(&c.xml);
+            for two_sided in [false, true] {
+                m.two_sided = two_sided;
+                for z in [0.0f32, -0.0] {
+                    let wi = Vec3::new(0.6, 0.8, z);
+                    let what = format!("{ty} (two-sided {two_sided}) at wi {wi:?}: {}", c.xml);
+                    for _ in 0..200 {
+                        let wo = crate::sampling::warps::square_to_uniform_sphere(rng.next_2d());
+                        assert_eq!(m.eval(wi, wo), Rgb::ZERO, "{what}, wo {wo}");
+                        assert_eq!(m.pdf(wi, wo), 0.0, "{what}, wo {wo}");
+                        if let Some(s) = m.sample(wi, rng.next_f32(), rng.next_2d()) {
+                            assert_eq!(s.weight, Rgb::ZERO, "{what}: sampled {}", s.wo);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
