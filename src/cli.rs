@@ -1,12 +1,9 @@
 //! Command-line interface.
 
-use crate::emitter::{EmitterSelection, LightSampling};
 use crate::film;
-use crate::integrator::Strategy;
+use crate::integrator::{Strategy, StrategyOverrides};
 use crate::render::{render, RenderSettings};
-use crate::scene::desc::{Heuristic, StrategyKind};
-use crate::scene::{load_scene, Scene};
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
@@ -141,99 +138,6 @@ fn cmd_reproduce(a: &ReproduceArgs) -> Result<(), String> {
     run_files(&files, &a.sweep)
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum StrategyArg {
-    Bsdf,
-    Light,
-    Mis,
-    MisOnesample,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum SelectionArg {
-    Uniform,
-    Power,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum LightSamplingArg {
-    Area,
-    SolidAngle,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum HeuristicArg {
-    Balance,
-    Power,
-}
-
-/// Estimator choices; anything not given keeps the scene's own integrator settings. Experiment
-/// files use the same names (`strategy = "mis"`, `emitter_selection = "power"`, ...).
-#[derive(Args, Debug, Clone, Default, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct StrategyArgs {
-    #[arg(long, value_enum)]
-    pub strategy: Option<StrategyArg>,
-    #[arg(long, value_enum)]
-    pub emitter_selection: Option<SelectionArg>,
-    #[arg(long, value_enum)]
-    pub light_sampling: Option<LightSamplingArg>,
-    #[arg(long, value_enum)]
-    pub heuristic: Option<HeuristicArg>,
-    #[arg(long)]
-    pub emitter_samples: Option<u32>,
-    #[arg(long)]
-    pub bsdf_samples: Option<u32>,
-}
-
-impl StrategyArgs {
-    /// `s` with these choices applied. Zero sample counts keep Mitsuba's meaning (see
-    /// [`StrategyKind::with_sample_counts`]); a choice that leaves nothing to sample is an
-    /// error.
-    pub fn apply(&self, mut s: Strategy) -> Result<Strategy, String> {
-        if let Some(k) = self.strategy {
-            s.kind = match k {
-                StrategyArg::Bsdf => StrategyKind::Bsdf,
-                StrategyArg::Light => StrategyKind::Light,
-                StrategyArg::Mis => StrategyKind::Mis,
-                StrategyArg::MisOnesample => StrategyKind::MisOneSample,
-            };
-        }
-        if let Some(e) = self.emitter_selection {
-            s.selection = match e {
-                SelectionArg::Uniform => EmitterSelection::Uniform,
-                SelectionArg::Power => EmitterSelection::Power,
-            };
-        }
-        if let Some(l) = self.light_sampling {
-            s.light_sampling = match l {
-                LightSamplingArg::Area => LightSampling::Area,
-                LightSamplingArg::SolidAngle => LightSampling::SolidAngle,
-            };
-        }
-        if let Some(h) = self.heuristic {
-            s.heuristic = match h {
-                HeuristicArg::Balance => Heuristic::Balance,
-                HeuristicArg::Power => Heuristic::Power,
-            };
-        }
-        if let Some(n) = self.emitter_samples {
-            s.emitter_samples = n;
-        }
-        if let Some(n) = self.bsdf_samples {
-            s.bsdf_samples = n;
-        }
-        s.kind = s
-            .kind
-            .with_sample_counts(s.emitter_samples, s.bsdf_samples)?;
-        Ok(s)
-    }
-}
-
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// Scene file (XML).
@@ -261,7 +165,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub stats: Option<PathBuf>,
     #[command(flatten)]
-    pub strategy: StrategyArgs,
+    pub strategy: StrategyOverrides,
 }
 
 fn parse_define(s: &str) -> Result<(String, String), String> {
@@ -272,19 +176,6 @@ fn parse_define(s: &str) -> Result<(String, String), String> {
         return Err(format!("expected name=value, found '{s}'"));
     }
     Ok((k.to_string(), v.to_string()))
-}
-
-/// Loads and builds a scene, printing its warnings to stderr. A film too large for this
-/// machine's memory is refused here, before any render starts.
-pub fn open_scene(path: &Path, defines: &[(String, String)]) -> Result<Scene, String> {
-    let desc = load_scene(path, defines).map_err(|e| e.to_string())?;
-    let scene = Scene::build(desc).map_err(|e| e.to_string())?;
-    crate::render::check_film_memory(scene.camera.width, scene.camera.height)
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    for w in &scene.warnings {
-        eprintln!("warning: {w}");
-    }
-    Ok(scene)
 }
 
 #[derive(serde::Serialize)]
@@ -342,7 +233,7 @@ fn render_outputs(a: &RenderArgs) -> Result<PathBuf, String> {
 
 fn cmd_render(a: &RenderArgs) -> Result<(), String> {
     let out = render_outputs(a)?;
-    let scene = open_scene(&a.scene, &a.define)?;
+    let scene = crate::scene::open(&a.scene, &a.define)?;
     let strategy = a
         .strategy
         .apply(Strategy::from_desc(&scene.desc.integrator))?;

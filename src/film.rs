@@ -120,9 +120,66 @@ pub fn write_png(path: &Path, img: &Image) -> Result<(), String> {
     write_png_rgb8(path, img.width, img.height, &to_srgb8(img, 1.0))
 }
 
+/// Bytes a render holds per pixel at its peak: each pixel's result as the workers return it
+/// (64 bytes), the mean and variance images (48), and the EXR and PNG encoders' copies
+/// (about 16).
+pub const BYTES_PER_PIXEL: u64 = 128;
+
+/// Refuses a film whose render would not fit in the memory this machine has available (or
+/// whose pixel count is beyond what the film's indices address), before rendering starts.
+pub fn check_film_memory(width: u32, height: u32) -> Result<(), String> {
+    check_film_memory_within(width, height, available_memory())
+}
+
+fn check_film_memory_within(width: u32, height: u32, available: Option<u64>) -> Result<(), String> {
+    let pixels = width as u64 * height as u64;
+    let need = pixels.saturating_mul(BYTES_PER_PIXEL);
+    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+    if pixels > u32::MAX as u64 {
+        return Err(format!(
+            "the film is {width}x{height} ({pixels} pixels), more than the {} pixels an image \
+             can hold",
+            u32::MAX
+        ));
+    }
+    match available {
+        Some(avail) if need > avail => Err(format!(
+            "the film is {width}x{height}: rendering it needs about {:.1} GiB of memory \
+             ({BYTES_PER_PIXEL} bytes per pixel), and this machine has {:.1} GiB available",
+            gib(need),
+            gib(avail)
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// `MemAvailable` of /proc/meminfo in bytes; None where it cannot be read (the check is then
+/// skipped rather than guessed).
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn film_memory_is_checked_against_what_is_available() {
+        let gib = 1u64 << 30;
+        assert!(check_film_memory_within(1024, 1024, Some(gib)).is_ok());
+        // 20000^2 pixels need about 48 GiB.
+        let e = check_film_memory_within(20000, 20000, Some(24 * gib)).unwrap_err();
+        assert!(e.contains("20000x20000") && e.contains("47.7 GiB"), "{e}");
+        assert!(e.contains("24.0 GiB available"), "{e}");
+        // Beyond 32-bit pixel indices, whatever the memory.
+        let e = check_film_memory_within(70000, 70000, None).unwrap_err();
+        assert!(e.contains("4900000000 pixels"), "{e}");
+        assert!(check_film_memory_within(60000, 60000, None).is_ok());
+        assert!(available_memory().is_some_and(|m| m > 0));
+    }
 
     #[test]
     fn exr_round_trip_and_no_temp_left() {

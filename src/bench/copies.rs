@@ -3,7 +3,7 @@
 //! one-core clock, a neighbour's load, a shared cache), and no renderer's threads scale past
 //! what independent copies of it reach at once: the thread speed-up is read against this.
 
-use super::throughput;
+use super::timing::throughput;
 use crate::integrator::Strategy;
 use crate::scene::Scene;
 use std::time::Instant;

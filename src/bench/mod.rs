@@ -13,15 +13,15 @@ mod raylimit;
 pub(crate) mod scaling;
 mod sweeps;
 mod throughput;
+mod timing;
 
-use crate::cli::open_scene;
 use crate::emitter::{EmitterSelection, LightSampling};
 use crate::integrator::Strategy;
 use crate::scene::desc::{Heuristic, StrategyKind};
 use crate::scene::Scene;
 use clap::Args;
 use std::path::PathBuf;
-use throughput::throughput;
+use timing::throughput;
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -155,7 +155,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         "scene", "strategy", "threads", "M samples/s"
     );
     for path in &scenes {
-        let scene = open_scene(path, &[("res".into(), a.res.to_string())])?;
+        let scene = crate::scene::open(path, &[("res".into(), a.res.to_string())])?;
         let name = path.display().to_string();
         // `res` sets the size of scenes that declare it; the others keep their own.
         println!("  {name}: {}x{}", scene.camera.width, scene.camera.height);

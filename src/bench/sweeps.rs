@@ -1,7 +1,7 @@
 //! Per-sample cost as the scene grows: the triangle and emitter sweeps over the scenes of
 //! `scaling`, and the emitter choice alone.
 
-use super::throughput::throughput;
+use super::timing::throughput;
 use super::{least, paired_ratio, power_mis, scaling, BenchArgs, Row};
 use crate::emitter::EmitterSelection;
 use crate::integrator::Strategy;

@@ -12,7 +12,8 @@ use crate::math::{luminance, Rgb, PI};
 use glam::{Vec2, Vec3};
 
 /// How a point on an area light is drawn.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum LightSampling {
     /// Uniform by area (the study's method), converted to solid angle.
     Area,

@@ -4,7 +4,8 @@ use super::Emitter;
 use crate::sampling::discrete::bin_index;
 use crate::sampling::AliasTable;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum EmitterSelection {
     Uniform,
     Power,

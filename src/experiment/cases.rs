@@ -3,8 +3,10 @@
 //! samples, and the input checks (`[[invalid]]`) and f64 accumulation check (`[accumulation]`)
 //! of stability suites such as `experiments/extreme.toml`.
 
-use crate::cli::{HeuristicArg, LightSamplingArg, SelectionArg, StrategyArg, StrategyArgs};
+use crate::emitter::{EmitterSelection, LightSampling};
 use crate::integrator::Strategy;
+use crate::integrator::StrategyOverrides;
+use crate::scene::desc::{Heuristic, StrategyKind};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -47,17 +49,17 @@ pub struct CaseReferenceSpec {
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct BlindSpec {
-    pub strategy: Option<StrategyArg>,
-    pub light_sampling: Option<LightSamplingArg>,
-    pub emitter_selection: Option<SelectionArg>,
-    pub heuristic: Option<HeuristicArg>,
+    pub strategy: Option<StrategyKind>,
+    pub light_sampling: Option<LightSampling>,
+    pub emitter_selection: Option<EmitterSelection>,
+    pub heuristic: Option<Heuristic>,
     /// Why, with the probability of the missed event (for the report).
     pub why: String,
 }
 
 impl BlindSpec {
     pub fn covers(&self, s: &Strategy) -> bool {
-        let only = StrategyArgs {
+        let only = StrategyOverrides {
             strategy: self.strategy,
             light_sampling: self.light_sampling,
             emitter_selection: self.emitter_selection,

@@ -7,7 +7,7 @@ use super::results::Row;
 use crate::metrics;
 use crate::render::RenderOutput;
 
-pub(super) fn measure(
+pub(crate) fn measure(
     r: &Reference,
     eps: f64,
     context: &str,

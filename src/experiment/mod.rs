@@ -10,13 +10,15 @@ pub mod leftout;
 mod measure;
 pub mod plan;
 pub mod probe;
+pub mod resolve;
 pub mod results;
 pub mod runner;
 pub mod schema;
 mod validate;
 
+pub use resolve::load;
 pub use runner::{run_experiment, Outcome, RunOptions};
-pub use schema::{load, Resolved};
+pub use schema::Resolved;
 use std::path::{Path, PathBuf};
 
 /// Runs one experiment file and writes its figures and report; prints the mean check (image

@@ -25,19 +25,19 @@ pub fn time_tag(budget: f64) -> String {
 }
 
 /// One render to do.
-pub(super) struct Job {
-    pub(super) name: String,
-    pub(super) strategy: Strategy,
-    pub(super) kind: &'static str,
-    pub(super) budget: f64,
-    pub(super) spp: u32,
-    pub(super) seed: u64,
+pub(crate) struct Job {
+    pub(crate) name: String,
+    pub(crate) strategy: Strategy,
+    pub(crate) kind: &'static str,
+    pub(crate) budget: f64,
+    pub(crate) spp: u32,
+    pub(crate) seed: u64,
     /// Where to keep the image for the figures, if it is needed.
-    pub(super) image: Option<PathBuf>,
+    pub(crate) image: Option<PathBuf>,
 }
 
 /// Two rows are the same run (one replaces the other) if their resume keys agree.
-pub(super) fn same_run(a: &Row, b: &Row) -> bool {
+pub(crate) fn same_run(a: &Row, b: &Row) -> bool {
     a.kind == b.kind
         && a.case == b.case
         && a.strategy == b.strategy
@@ -49,22 +49,22 @@ pub(super) fn same_run(a: &Row, b: &Row) -> bool {
         }
 }
 
-pub(super) fn has_image(p: &Option<PathBuf>) -> bool {
+pub(crate) fn has_image(p: &Option<PathBuf>) -> bool {
     p.as_ref()
         .is_none_or(|p| p.exists() && variance_path(p).exists())
 }
 
 /// What the sweep covers, and which seed-0 images the figures need.
-pub(super) struct Sweep<'a> {
-    pub(super) spp: &'a [u32],
-    pub(super) seeds: u32,
-    pub(super) keep_spp: &'a [u32],
-    pub(super) dir: &'a Path,
+pub(crate) struct Sweep<'a> {
+    pub(crate) spp: &'a [u32],
+    pub(crate) seeds: u32,
+    pub(crate) keep_spp: &'a [u32],
+    pub(crate) dir: &'a Path,
 }
 
 /// The sweep's renders still to do: rows missing from `results`, and rows whose image the
 /// figures need but which is missing (seeds give the same image again, so the row is redone).
-pub(super) fn plan_sweep(results: &Results, kept: &[(String, Strategy)], sw: &Sweep) -> Vec<Job> {
+pub(crate) fn plan_sweep(results: &Results, kept: &[(String, Strategy)], sw: &Sweep) -> Vec<Job> {
     let mut jobs = Vec::new();
     for seed in 0..sw.seeds as u64 {
         for &spp in sw.spp {
@@ -91,7 +91,7 @@ pub(super) fn plan_sweep(results: &Results, kept: &[(String, Strategy)], sw: &Sw
 
 /// Samples per second of a strategy over its sweep rows (dominated by the long runs, where
 /// per-render overhead is negligible).
-pub(super) fn rate(rows: &[Row], label: &str) -> Option<f64> {
+pub(crate) fn rate(rows: &[Row], label: &str) -> Option<f64> {
     let (mut samples, mut secs) = (0.0, 0.0);
     for r in rows.iter().filter(|r| r.is_sweep() && r.strategy == label) {
         samples += r.samples_per_s * r.seconds;

@@ -9,7 +9,6 @@ use super::plan::{
 };
 use super::results::{Results, Row, EQUAL_TIME};
 use super::schema::Resolved;
-use crate::cli::open_scene;
 use crate::film;
 use crate::integrator::Strategy;
 use crate::render::{render, RenderSettings};
@@ -141,7 +140,7 @@ fn rendered_reference(
 pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, String> {
     let start = Instant::now();
     let dir = opts.out.join(&exp.name);
-    let scene = open_scene(exp.scene(), exp.defines())?;
+    let scene = crate::scene::open(exp.scene(), exp.defines())?;
     let base = Strategy::from_desc(&scene.desc.integrator);
     let listed: Vec<(String, Strategy)> = exp
         .exp

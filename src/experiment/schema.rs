@@ -6,8 +6,9 @@
 //! A file names one `scene`, or several `[[case]]`s (see `cases.rs`).
 
 use super::cases::{AccumulationSpec, Case, CaseSpec, ClosedForm, InvalidSpec, ProbeSpec};
-use super::validate::{cases, validate, validate_cases};
-use crate::cli::{HeuristicArg, LightSamplingArg, SelectionArg, StrategyArg, StrategyArgs};
+use crate::emitter::{EmitterSelection, LightSampling};
+use crate::integrator::StrategyOverrides;
+use crate::scene::desc::{Heuristic, StrategyKind};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -62,17 +63,17 @@ fn default_seeds() -> u32 {
 pub struct StrategySpec {
     /// Legend name; the CSV and file names use the strategy's stable label instead.
     pub name: String,
-    pub strategy: Option<StrategyArg>,
-    pub emitter_selection: Option<SelectionArg>,
-    pub light_sampling: Option<LightSamplingArg>,
-    pub heuristic: Option<HeuristicArg>,
+    pub strategy: Option<StrategyKind>,
+    pub emitter_selection: Option<EmitterSelection>,
+    pub light_sampling: Option<LightSampling>,
+    pub heuristic: Option<Heuristic>,
     pub emitter_samples: Option<u32>,
     pub bsdf_samples: Option<u32>,
 }
 
 impl StrategySpec {
-    pub fn args(&self) -> StrategyArgs {
-        StrategyArgs {
+    pub fn args(&self) -> StrategyOverrides {
+        StrategyOverrides {
             strategy: self.strategy,
             emitter_selection: self.emitter_selection,
             light_sampling: self.light_sampling,
@@ -104,7 +105,7 @@ pub struct ReferenceSpec {
     pub closed_form: Option<ClosedForm>,
     /// Estimator of the reference (CLI names); unset fields keep the scene's integrator.
     #[serde(default)]
-    pub strategy: StrategyArgs,
+    pub strategy: StrategyOverrides,
     /// Must differ from the sweep's seeds 0..seeds, or the reference would share samples
     /// with a run and their errors would be correlated.
     #[serde(default = "default_reference_seed")]
@@ -121,7 +122,7 @@ impl Default for ReferenceSpec {
             spp: None,
             value: None,
             closed_form: None,
-            strategy: StrategyArgs::default(),
+            strategy: StrategyOverrides::default(),
             seed: default_reference_seed(),
         }
     }
@@ -262,67 +263,6 @@ impl Resolved {
             .variance_spp
             .unwrap_or_else(|| *self.exp.spp.iter().max().expect("validated non-empty"))
     }
-}
-
-pub fn parse(text: &str, file: &Path) -> Result<Experiment, String> {
-    toml::from_str(text).map_err(|e| format!("{}: {e}", file.display()))
-}
-
-/// Reads, applies `--quick` and validates an experiment file.
-pub fn load(file: &Path, quick: bool) -> Result<Resolved, String> {
-    let text = std::fs::read_to_string(file)
-        .map_err(|e| format!("{}: cannot read experiment: {e}", file.display()))?;
-    resolve(parse(&text, file)?, file, quick)
-}
-
-pub fn resolve(mut exp: Experiment, file: &Path, quick: bool) -> Result<Resolved, String> {
-    let stem = file
-        .file_stem()
-        .map(|s| s.to_string_lossy().to_string())
-        .unwrap_or_else(|| "experiment".into());
-    let mut name = exp.name.clone().unwrap_or(stem);
-    if quick {
-        let q = exp.quick.clone().unwrap_or_default();
-        exp.defines.extend(q.defines);
-        if let Some(s) = q.spp {
-            exp.spp = s;
-        }
-        if let Some(s) = q.seeds {
-            exp.seeds = s;
-        }
-        if let Some(s) = q.reference_spp {
-            exp.reference.spp = Some(s);
-        }
-        if let (Some(t), Some(et)) = (q.equal_time_seconds, exp.equal_time.as_mut()) {
-            et.seconds = t;
-        }
-        if q.equal_spp.is_some() {
-            exp.figures.equal_spp = q.equal_spp;
-        }
-        // The full run's variance spp is rarely in the quick sweep: use the quick maximum.
-        exp.figures.variance_spp = None;
-        if let Some(p) = q.progression {
-            exp.figures.progression = p;
-        }
-        if let (Some(n), Some(p)) = (q.probe_samples, exp.probe.as_mut()) {
-            p.samples = n;
-        }
-        if let (Some(n), Some(a)) = (q.accumulation_spp, exp.accumulation.as_mut()) {
-            a.spp = n;
-        }
-        // Quick results live apart, so they never mix with (or resume into) the full run.
-        name.push_str("-quick");
-    }
-    validate(&exp, file)?;
-    let cases = cases(&exp, file)?;
-    validate_cases(&exp, &cases, file)?;
-    Ok(Resolved {
-        name,
-        file: file.to_path_buf(),
-        quick,
-        exp,
-        cases,
-    })
 }
 
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! Tests of experiment files: parsing, `--quick`, and the checks that name file and key.
 
 use super::*;
+use crate::experiment::resolve::{parse, resolve};
 
 const EXAMPLE: &str = r#"
     title = "demo"
@@ -41,19 +42,19 @@ fn parses_the_example_and_applies_quick() {
     assert_eq!(exp.strategies.len(), 2);
     assert!(matches!(
         exp.strategies[0].strategy,
-        Some(StrategyArg::Light)
+        Some(StrategyKind::Light)
     ));
     assert!(matches!(
         exp.strategies[0].light_sampling,
-        Some(LightSamplingArg::SolidAngle)
+        Some(LightSampling::SolidAngle)
     ));
     assert!(matches!(
         exp.strategies[1].strategy,
-        Some(StrategyArg::MisOnesample)
+        Some(StrategyKind::MisOneSample)
     ));
     assert!(matches!(
         exp.reference.strategy.heuristic,
-        Some(HeuristicArg::Balance)
+        Some(Heuristic::Balance)
     ));
     assert_eq!(exp.metrics.relmse_epsilon, 0.001);
 

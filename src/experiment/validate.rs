@@ -8,7 +8,7 @@ use std::path::Path;
 
 /// The cases of a file: its `[[case]]`s, or its single `scene` as an unnamed case. A case's
 /// own defines win over the file's (which `--quick` has already updated).
-pub(super) fn cases(exp: &Experiment, file: &Path) -> Result<Vec<Case>, String> {
+pub(crate) fn cases(exp: &Experiment, file: &Path) -> Result<Vec<Case>, String> {
     let dir = file.parent().unwrap_or(Path::new("."));
     let single;
     let specs: &[CaseSpec] = match (&exp.scene, exp.cases.is_empty()) {
@@ -59,7 +59,7 @@ pub(super) fn cases(exp: &Experiment, file: &Path) -> Result<Vec<Case>, String> 
 /// The longest equal-time budget accepted: anything longer is a typo, not an experiment.
 const MAX_EQUAL_TIME_SECONDS: f64 = 7.0 * 86400.0;
 
-pub(super) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
+pub(crate) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
     let fail = |m: String| Err(format!("{}: {m}", file.display()));
     if exp.spp.is_empty() || exp.spp.contains(&0) {
         return fail("`spp` needs at least one value, all positive".into());
@@ -155,7 +155,7 @@ pub(super) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
 
 /// Checks that depend on the mode: an image sweep has one scene and a rendered or constant
 /// reference; probe mode has named cases with closed-form values, and its own keys.
-pub(super) fn validate_cases(exp: &Experiment, cases: &[Case], file: &Path) -> Result<(), String> {
+pub(crate) fn validate_cases(exp: &Experiment, cases: &[Case], file: &Path) -> Result<(), String> {
     let fail = |m: String| Err(format!("{}: {m}", file.display()));
     let r = &exp.reference;
     let Some(p) = &exp.probe else {

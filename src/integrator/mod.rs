@@ -9,7 +9,7 @@ mod strategy;
 
 pub use direct::Direct;
 pub use lanes::LaneScratch;
-pub use strategy::Strategy;
+pub use strategy::{Strategy, StrategyOverrides};
 
 #[cfg(test)]
 pub(crate) mod tests;

@@ -105,6 +105,44 @@ impl Strategy {
     }
 }
 
+/// Estimator choices on top of a scene's own integrator settings: `render`'s options and an
+/// experiment's strategy entries (`strategy = "mis"`, `emitter_selection = "power"`, ...), with
+/// the same names in both. Anything not given keeps the scene's setting.
+#[derive(clap::Args, Debug, Clone, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StrategyOverrides {
+    #[arg(long, value_enum)]
+    pub strategy: Option<StrategyKind>,
+    #[arg(long, value_enum)]
+    pub emitter_selection: Option<EmitterSelection>,
+    #[arg(long, value_enum)]
+    pub light_sampling: Option<LightSampling>,
+    #[arg(long, value_enum)]
+    pub heuristic: Option<Heuristic>,
+    #[arg(long)]
+    pub emitter_samples: Option<u32>,
+    #[arg(long)]
+    pub bsdf_samples: Option<u32>,
+}
+
+impl StrategyOverrides {
+    /// `s` with these choices applied. Zero sample counts keep Mitsuba's meaning (see
+    /// [`StrategyKind::with_sample_counts`]); a choice that leaves nothing to sample is an
+    /// error.
+    pub fn apply(&self, mut s: Strategy) -> Result<Strategy, String> {
+        s.kind = self.strategy.unwrap_or(s.kind);
+        s.selection = self.emitter_selection.unwrap_or(s.selection);
+        s.light_sampling = self.light_sampling.unwrap_or(s.light_sampling);
+        s.heuristic = self.heuristic.unwrap_or(s.heuristic);
+        s.emitter_samples = self.emitter_samples.unwrap_or(s.emitter_samples);
+        s.bsdf_samples = self.bsdf_samples.unwrap_or(s.bsdf_samples);
+        s.kind = s
+            .kind
+            .with_sample_counts(s.emitter_samples, s.bsdf_samples)?;
+        Ok(s)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,7 +2,7 @@
 //! intervals from the variance images, z-tests Sidak-corrected over all comparisons.
 
 use crate::experiment::analysis::{mean_difference, pooled_means, MeanDiff, PooledMean};
-use crate::experiment::Outcome;
+use crate::experiment::runner::Outcome;
 use crate::stats::{sidak, TAIL_SHARE};
 use std::fmt::Write;
 

@@ -10,7 +10,7 @@ pub use means::{mean_check, mean_check_lines, Comparison, MEAN_ALPHA};
 
 use crate::experiment::analysis::{metric_name, Series};
 use crate::experiment::figures::Figure;
-use crate::experiment::Outcome;
+use crate::experiment::runner::Outcome;
 use crate::output::write_atomic;
 use std::fmt::Write;
 use std::path::Path;

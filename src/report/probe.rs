@@ -4,7 +4,7 @@
 
 pub use super::probe_table::{critical, table, table_spp, TableRow, BIASED, NON_FINITE, OK, TAIL};
 use crate::experiment::analysis::metric_name;
-use crate::experiment::probe::ProbeOutcome;
+use crate::experiment::probe::run::ProbeOutcome;
 use crate::output::write_atomic;
 use std::fmt::Write as _;
 

@@ -1,8 +1,8 @@
 //! The probe report's table: every (case, strategy) pooled over seeds, with its verdict.
 
 use crate::experiment::analysis::series;
+use crate::experiment::probe::run::{CaseRun, ProbeOutcome};
 use crate::experiment::probe::stats::z_score;
-use crate::experiment::probe::{CaseRun, ProbeOutcome};
 use crate::experiment::results::Row;
 
 pub const OK: &str = "ok";

@@ -4,8 +4,8 @@
 use super::e;
 use crate::experiment::analysis::{error_of, metric_name, predicted_of, Series};
 use crate::experiment::results::{Row, EQUAL_TIME};
+use crate::experiment::runner::Outcome;
 use crate::experiment::schema::ErrorMetric;
-use crate::experiment::Outcome;
 use std::fmt::Write;
 
 pub(super) fn error_table(md: &mut String, o: &Outcome, series: &[Series]) {

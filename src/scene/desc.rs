@@ -75,7 +75,8 @@ pub struct SamplerDesc {
 
 /// How a direct-lighting estimator combines its techniques; scenes name one, the CLI may
 /// override it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum StrategyKind {
     /// BSDF sampling only (Nori `material`).
     Bsdf,
@@ -84,6 +85,8 @@ pub enum StrategyKind {
     /// Multi-sample MIS of light and BSDF samples.
     Mis,
     /// One-sample MIS: each sample picks one technique at random.
+    #[value(name = "mis-onesample")]
+    #[serde(rename = "mis-onesample")]
     MisOneSample,
 }
 
@@ -111,7 +114,8 @@ impl StrategyKind {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Heuristic {
     Balance,
     Power,

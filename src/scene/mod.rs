@@ -53,3 +53,16 @@ mod bsdf_ray_tests;
 pub(crate) mod bundled_tests;
 #[cfg(test)]
 pub(crate) mod random;
+
+/// Loads and builds a scene, printing its warnings to stderr. A film too large for this
+/// machine's memory is refused here, before any render starts.
+pub fn open(path: &std::path::Path, defines: &[(String, String)]) -> Result<Scene, String> {
+    let desc = load_scene(path, defines).map_err(|e| e.to_string())?;
+    let scene = Scene::build(desc).map_err(|e| e.to_string())?;
+    crate::film::check_film_memory(scene.camera.width, scene.camera.height)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(scene)
+}

@@ -10,7 +10,7 @@ use plotters::prelude::*;
 pub const FILE: &str = "convergence.png";
 
 /// The panels' series, in `figures.panels` order.
-pub(super) fn panel_series(o: &ProbeOutcome) -> Vec<(String, Vec<Series>)> {
+pub(crate) fn panel_series(o: &ProbeOutcome) -> Vec<(String, Vec<Series>)> {
     let m = o.exp.exp.metrics.primary;
     o.exp
         .exp
@@ -28,7 +28,7 @@ pub(super) fn panel_series(o: &ProbeOutcome) -> Vec<(String, Vec<Series>)> {
 }
 
 /// Writes the figure; `None` when the experiment names no panels.
-pub(super) fn write(o: &ProbeOutcome) -> Result<Option<String>, String> {
+pub(crate) fn write(o: &ProbeOutcome) -> Result<Option<String>, String> {
     let panels = panel_series(o);
     if panels.is_empty() {
         return Ok(None);

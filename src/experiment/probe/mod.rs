@@ -10,7 +10,7 @@ pub mod closed_form;
 mod figure;
 pub mod invalid;
 mod rows;
-mod run;
+pub mod run;
 pub mod samples;
 pub mod stats;
 

@@ -6,7 +6,7 @@ use super::stats::{batch_mse, norm, Stream};
 use crate::experiment::results::{Row, SWEEP};
 
 /// Where a stream came from and what it is measured against.
-pub(super) struct StreamInfo<'a> {
+pub(crate) struct StreamInfo<'a> {
     pub case: &'a str,
     pub context: &'a str,
     pub name: &'a str,
@@ -17,7 +17,7 @@ pub(super) struct StreamInfo<'a> {
     pub seconds: f64,
 }
 
-pub(super) fn rows(
+pub(crate) fn rows(
     info: &StreamInfo,
     x: &[f64],
     drawn: &Drawn,

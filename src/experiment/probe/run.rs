@@ -329,7 +329,7 @@ fn run_accumulation(
         .expect("validated: the case exists");
     let own: BTreeMap<String, String> = c.case.defines.iter().cloned().collect();
     let defines = crate::experiment::cases::merge_defines(&[&own, &a.defines]);
-    let scene = crate::cli::open_scene(&c.case.scene, &defines)?;
+    let scene = crate::scene::open(&c.case.scene, &defines)?;
     let base = Strategy::from_desc(&scene.desc.integrator);
     let mut h = Fnv::new();
     h.field(c.context.as_bytes());
