@@ -13,16 +13,14 @@ use std::time::Duration;
 /// Triangles per packet, and so the most primitives a BVH leaf may hold.
 const LEAF_SIZE: usize = 4;
 /// Primitive count above which the BVH is built with obvhs's fuller leaves: a large mesh's
-/// structure outgrows the caches, and fewer nodes and leaves then beat cheaper leaves. The
-/// bench's tessellated sphere at 2 threads (three interleaved runs each): 1e4 triangles level,
-/// 1e5 about 7 % and 1e6 about 11 % less time per sample.
+/// structure outgrows the caches, and fewer nodes and leaves then beat cheaper leaves (level
+/// at 1e4 triangles in the bench's sweep, ahead above it).
 const FULL_LEAVES_FROM: usize = 10_000;
 
 /// Primitive count above which the binary BVH is built with obvhs's slow preset (wider PLOC
-/// search, more reinsertion). The bench's tessellated sphere, 1 thread, five pairs of sweeps
-/// side by side on the two cores: at 1e6 triangles 0.86-0.96x the time per sample (median
-/// 0.88x, all five pairs), for a build of 1.64 s instead of 0.63 s; at 1e5 no gain (median
-/// 1.03x, 2 of 5 pairs), so the switch sits between the two.
+/// search, more reinsertion): its better tree pays for the longer build at a million
+/// triangles and not yet at a hundred thousand (reports/bench/NOTES.md), so the switch sits
+/// between the two.
 const QUALITY_BUILD_FROM: usize = 300_000;
 
 /// One BVH leaf: its triangles as a packet and its spheres.
@@ -157,10 +155,10 @@ impl Accel {
         }
         let params = BvhBuildParams {
             max_prims_per_leaf: LEAF_SIZE as u32,
-            // obvhs's default of 3 makes leaves of 3-4 triangles; with 8-wide nodes a lower
-            // cost per node visit is the better guess for small scenes (replayed cbox +
-            // veach-mis rays: 477 -> 421 ns for the three rays of a sample at 1; 0.5 is the
-            // same), but not for large ones (see `FULL_LEAVES_FROM`).
+            // obvhs's default of 3 makes leaves of 3-4 triangles; with 8-wide nodes a node
+            // visit is cheap, so a lower cost per visit is the better guess for small scenes
+            // (measured on the bundled scenes' rays), but not for large ones (see
+            // `FULL_LEAVES_FROM`).
             collapse_traversal_cost: if prims.len() > FULL_LEAVES_FROM {
                 3.0
             } else {
