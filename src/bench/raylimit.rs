@@ -16,7 +16,7 @@
 //! tens of MB from memory.
 
 use crate::emitter::{EmitterSelection, EmitterSelector, LightSampling};
-use crate::geometry::packet::bits;
+use crate::geometry::ray_packet::bits;
 use crate::geometry::shape::intersect_sphere;
 use crate::geometry::{Hit, PacketHits, Ray, RayPacket, ShapeKind};
 use crate::math::{Frame, Rgb};

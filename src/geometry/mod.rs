@@ -4,7 +4,7 @@ pub mod accel;
 mod bvh;
 mod lanes8;
 pub mod packet;
-mod ray_packet;
+pub mod ray_packet;
 mod refine;
 pub mod shape;
 mod sphere8;

@@ -14,27 +14,13 @@ use super::accel::{surface_point, Accel};
 use super::bvh::{push_by_distance, read, slab_inv8, slab_test, Node, WideBvh};
 use super::bvh::{LEAF, ROBUST, STACK};
 use super::lanes8::{F8, M8};
+use super::ray_packet::{bits, PACKET};
 use super::ray_packet::{PacketHits, RayPacket};
 use super::shape::{intersect_sphere, ShapeKind};
 use super::watertight8::{Lanes3, Rays8, WatertightRay8};
 use super::{Ray, Shape};
 use glam::Vec2;
 use std::mem::MaybeUninit;
-
-/// Rays per packet.
-pub const PACKET: usize = 8;
-
-/// Iterates the set bits of a mask, lowest first.
-#[inline(always)]
-pub fn bits(mut m: u32) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (m != 0).then(|| {
-            let i = m.trailing_zeros() as usize;
-            m &= m - 1;
-            i
-        })
-    })
-}
 
 /// Transposes an 8x8 bit matrix: bit 8r + c goes to bit 8c + r (Hacker's Delight 7-3).
 #[inline(always)]

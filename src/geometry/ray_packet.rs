@@ -2,8 +2,22 @@
 //! read and write, and the form the lane kernel and the camera compute in, so that nothing is
 //! transposed between them.
 
-use super::packet::PACKET;
 use super::{Hit, Ray, SurfacePoint};
+
+/// Rays per packet.
+pub const PACKET: usize = 8;
+
+/// Iterates the set bits of a mask, lowest first.
+#[inline(always)]
+pub fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (m != 0).then(|| {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            i
+        })
+    })
+}
 use glam::Vec3;
 
 /// Lane i of three arrays.

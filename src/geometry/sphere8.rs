@@ -6,8 +6,7 @@
 //! Each lane computes bitwise what `intersect_sphere` computes, so a ray that query hits is
 //! a hit here: the pre-test never drops a hit of the closest-hit query after it.
 
-use super::packet::{bits, PACKET};
-use super::ray_packet::RayPacket;
+use super::ray_packet::{bits, RayPacket, PACKET};
 use super::shape::sphere_roots;
 use glam::Vec3;
 

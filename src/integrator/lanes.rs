@@ -23,7 +23,7 @@ use super::direct::{heuristic, Direct};
 use super::lane_tables::{LaneMaterial, LaneShape};
 use super::lanes_light::{light_sample, LightDraws, SphereDraws};
 use crate::bsdf::{BsdfSample, Diffuse};
-use crate::geometry::packet::bits;
+use crate::geometry::ray_packet::bits;
 use crate::geometry::{Accel, PacketHits, RayPacket};
 use crate::math::{Frame, Rgb};
 use crate::rng::{RngLanes, LANES};
@@ -31,7 +31,7 @@ use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 
 // A pixel's eight samples trace their camera and shadow rays as one packet.
-const _: () = assert!(LANES == crate::geometry::packet::PACKET);
+const _: () = assert!(LANES == crate::geometry::ray_packet::PACKET);
 
 /// The light and BSDF sample counts of the only strategies the lanes cover
 /// (`lane_tables::lane_lights`). As constants, `li`'s divisions by them (six per batch) and

@@ -8,7 +8,7 @@ use super::direct::Direct;
 use super::lane_tables::{LaneLight, LaneLightKind, LightTriangle, SmallLights, SmallMesh};
 use super::lanes::V3x8;
 use crate::emitter::{area_pdf_along, sample_at, sphere_area_point};
-use crate::geometry::packet::bits;
+use crate::geometry::ray_packet::bits;
 use crate::geometry::{lookup8, Mesh, Sphere, SurfacePoint};
 use crate::math::Rgb;
 use crate::rng::LANES;

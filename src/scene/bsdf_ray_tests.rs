@@ -4,7 +4,7 @@
 
 use super::Scene;
 use crate::emitter::LightSampling;
-use crate::geometry::packet::PACKET;
+use crate::geometry::ray_packet::PACKET;
 use crate::geometry::{Hit, RayPacket};
 use crate::rng::Rng;
 use crate::sampling::warps::square_to_uniform_sphere;
