@@ -2,7 +2,8 @@
 
 use glam::{Vec3, Vec3A};
 
-pub use crate::scene::desc::Rgb;
+/// Linear RGB triple used for colours, radiance and intensities.
+pub type Rgb = glam::Vec3;
 
 pub const PI: f32 = std::f32::consts::PI;
 pub const INV_PI: f32 = std::f32::consts::FRAC_1_PI;

@@ -95,23 +95,21 @@ fn lane_samples_are_bitwise_the_per_sample_definition() {
     // Rougher plates, seen at grazing angles: their slope inversions need the
     // lanes' extra vector step after the fixed ones.
     let rough_plates = |d: &mut SceneDesc| {
-        use crate::scene::desc::BsdfDesc;
+        use crate::bsdf::BsdfKind;
+        use crate::sampling::microfacet::Microfacet;
         for shape in &mut d.shapes {
-            if let BsdfDesc::RoughConductor {
-                alpha_u, alpha_v, ..
-            } = &mut shape.bsdf
-            {
-                (*alpha_u, *alpha_v) = (0.4, 0.4);
+            if let BsdfKind::RoughConductor(rc) = &mut shape.bsdf.kind {
+                rc.mf = Microfacet::new(rc.mf.distribution, 0.4, 0.4);
             }
         }
     };
     // Plates of a grey index other than the scene's eta 0, k 1, whose conductor term is
     // exactly 1 at every angle: the lanes' Fresnel with a value to get wrong.
     let grey_plates = |d: &mut SceneDesc| {
-        use crate::scene::desc::BsdfDesc;
+        use crate::bsdf::BsdfKind;
         for shape in &mut d.shapes {
-            if let BsdfDesc::RoughConductor { eta, k, .. } = &mut shape.bsdf {
-                (*eta, *k) = (Vec3::splat(0.2), Vec3::splat(3.0));
+            if let BsdfKind::RoughConductor(rc) = &mut shape.bsdf.kind {
+                (rc.eta, rc.k) = (Vec3::splat(0.2), Vec3::splat(3.0));
             }
         }
     };

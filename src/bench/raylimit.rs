@@ -557,15 +557,16 @@ pub fn measure_obvhs(scene: &Scene, mix: &RayMix, repeat: u32) -> RayLimit {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::{BsdfKind, Material, RoughConductor};
     use crate::math::look_at;
+    use crate::sampling::microfacet::Microfacet;
     use crate::sampling::microfacet::MicrofacetDistribution;
-    use crate::scene::desc::BsdfDesc;
     use crate::scene::fixtures;
     use glam::Vec3;
 
     /// The floor seen from (0, -1, 1) under a triangle light that emits towards it, from 2
     /// above it or (`below`) from 2 below it, behind the floor's one-sided diffuse surface.
-    fn floor_and_light(below: bool, floor: Option<BsdfDesc>) -> Scene {
+    fn floor_and_light(below: bool, floor: Option<Material>) -> Scene {
         let z = if below { -2.0 } else { 2.0 };
         let mut tri = [
             Vec3::new(-1.0, -1.0, z),
@@ -735,15 +736,13 @@ mod tests {
     /// them all do with probability below 1e-100.
     #[test]
     fn bsdf_rays_are_the_materials_draws() {
-        let rough = BsdfDesc::RoughConductor {
-            distribution: MicrofacetDistribution::Beckmann,
-            alpha_u: 0.01,
-            alpha_v: 0.01,
+        let rough = fixtures::one_sided(BsdfKind::RoughConductor(RoughConductor {
+            mf: Microfacet::new(MicrofacetDistribution::Beckmann, 0.01, 0.01),
             sample_visible: true,
             eta: Rgb::splat(0.0),
             k: Rgb::splat(1.0),
             specular_reflectance: Rgb::splat(1.0),
-        };
+        }));
         let scene = floor_and_light(false, Some(rough));
         let mix = ray_mix(&scene, 64, EmitterSelection::Uniform);
         assert_eq!(mix.bsdf.len(), 64);

@@ -3,11 +3,14 @@
 
 use super::fresnel::fresnel_conductor;
 use super::mirror::reflect_z;
+use super::params::{self, Params};
+use super::Bsdf;
 use super::BsdfSample;
 use crate::math::Rgb;
+use glam::Vec2;
 use glam::Vec3;
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Conductor {
     pub eta: Rgb,
     pub k: Rgb,
@@ -26,6 +29,29 @@ impl Conductor {
             pdf: 1.0,
             delta: true,
         })
+    }
+}
+
+impl Bsdf for Conductor {
+    const DELTA: bool = true;
+
+    /// `eta` and `k`, or a `material` name; `specular_reflectance` (default 1).
+    fn from_params<P: Params>(p: &mut P) -> Result<Self, P::Error> {
+        let (eta, k, specular_reflectance) = params::conductor(p)?;
+        Ok(Conductor {
+            eta,
+            k,
+            specular_reflectance,
+        })
+    }
+    fn eval(&self, _: Vec3, _: Vec3) -> Rgb {
+        Rgb::ZERO
+    }
+    fn pdf(&self, _: Vec3, _: Vec3) -> f32 {
+        0.0
+    }
+    fn sample(&self, wi: Vec3, _: f32, _: Vec2) -> Option<BsdfSample> {
+        Conductor::sample(self, wi)
     }
 }
 

@@ -9,11 +9,14 @@
 
 use super::fresnel::fresnel_dielectric;
 use super::mirror::reflect_z;
+use super::params::{self, Params};
+use super::Bsdf;
 use super::BsdfSample;
 use crate::math::Rgb;
+use glam::Vec2;
 use glam::Vec3;
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Dielectric {
     /// int_ior / ext_ior.
     pub eta: f32,
@@ -42,6 +45,33 @@ impl Dielectric {
                 delta: true,
             }
         })
+    }
+}
+
+impl Bsdf for Dielectric {
+    const DELTA: bool = true;
+    // As Mitsuba: the inside is meaningful, so mirroring it to the outside would turn
+    // refraction into nonsense.
+    const TWO_SIDED: bool = false;
+
+    /// `int_ior` and `ext_ior`, numbers or Mitsuba's names (default BK7 in air).
+    fn from_params<P: Params>(p: &mut P) -> Result<Self, P::Error> {
+        let int_ior = params::ior(p, "int_ior", params::DEFAULT_INT_IOR)?;
+        let ext_ior = params::ior(p, "ext_ior", params::DEFAULT_EXT_IOR)?;
+        p.reject("specular_reflectance")?;
+        p.reject("specular_transmittance")?;
+        Ok(Dielectric {
+            eta: int_ior / ext_ior,
+        })
+    }
+    fn eval(&self, _: Vec3, _: Vec3) -> Rgb {
+        Rgb::ZERO
+    }
+    fn pdf(&self, _: Vec3, _: Vec3) -> f32 {
+        0.0
+    }
+    fn sample(&self, wi: Vec3, u1: f32, _: Vec2) -> Option<BsdfSample> {
+        Dielectric::sample(self, wi, u1)
     }
 }
 

@@ -1,11 +1,13 @@
 //! Lambertian reflection, one-sided (black from behind unless wrapped in a two-sided material).
 
+use super::params::{checked_reflectance, Params};
+use super::Bsdf;
 use super::BsdfSample;
 use crate::math::{Rgb, INV_PI};
 use crate::sampling::warps::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use glam::{Vec2, Vec3};
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Diffuse {
     pub reflectance: Rgb,
 }
@@ -43,6 +45,37 @@ impl Diffuse {
             pdf,
             delta: false,
         })
+    }
+}
+
+impl Bsdf for Diffuse {
+    const DELTA: bool = false;
+
+    /// Mitsuba's `reflectance` (or Mitsuba 0.6's and Nori's `albedo`), default 0.5.
+    fn from_params<P: Params>(p: &mut P) -> Result<Self, P::Error> {
+        let r = p.color("reflectance")?;
+        let a = p.color("albedo")?;
+        let reflectance = match (r, a) {
+            (Some(_), Some(_)) => {
+                return Err(p.error(
+                    None,
+                    "give either 'reflectance' or 'albedo', not both".into(),
+                ))
+            }
+            (Some(v), None) => checked_reflectance(p, "reflectance", v)?,
+            (None, Some(v)) => checked_reflectance(p, "albedo", v)?,
+            (None, None) => Rgb::splat(0.5),
+        };
+        Ok(Diffuse { reflectance })
+    }
+    fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
+        Diffuse::eval(self, wi, wo)
+    }
+    fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+        Diffuse::pdf(self, wi, wo)
+    }
+    fn sample(&self, wi: Vec3, _: f32, u2: Vec2) -> Option<BsdfSample> {
+        Diffuse::sample(self, wi, u2)
     }
 }
 

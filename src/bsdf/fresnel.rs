@@ -173,7 +173,7 @@ mod tests {
     fn conductor_f32_matches_f64() {
         let mut values: Vec<f32> = vec![0.0, 1.0];
         values.extend((0..=60).map(|i| 10f32.powf(-3.0 + i as f32 * 0.15)));
-        for (_, eta, k) in crate::scene::METALS {
+        for (_, eta, k) in crate::bsdf::params::METALS {
             values.extend(eta.iter().chain(k.iter()));
         }
         let mut worst = (0.0f64, 0.0, 0.0, 0.0);

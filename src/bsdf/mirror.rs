@@ -1,10 +1,13 @@
 //! Nori `mirror`: perfect specular reflection with reflectance 1, one-sided.
 
+use super::params::Params;
+use super::Bsdf;
 use super::BsdfSample;
 use crate::math::Rgb;
+use glam::Vec2;
 use glam::Vec3;
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Mirror;
 
 /// Mirror direction about the local normal.
@@ -25,6 +28,24 @@ impl Mirror {
             pdf: 1.0,
             delta: true,
         })
+    }
+}
+
+impl Bsdf for Mirror {
+    const DELTA: bool = true;
+
+    /// No parameters.
+    fn from_params<P: Params>(_: &mut P) -> Result<Self, P::Error> {
+        Ok(Mirror)
+    }
+    fn eval(&self, _: Vec3, _: Vec3) -> Rgb {
+        Rgb::ZERO
+    }
+    fn pdf(&self, _: Vec3, _: Vec3) -> f32 {
+        0.0
+    }
+    fn sample(&self, wi: Vec3, _: f32, _: Vec2) -> Option<BsdfSample> {
+        Mirror::sample(self, wi)
     }
 }
 

@@ -10,6 +10,7 @@ mod diffuse;
 pub mod fresnel;
 mod mirror;
 mod nori_microfacet;
+pub mod params;
 mod roughconductor;
 
 pub use conductor::Conductor;
@@ -21,6 +22,7 @@ pub use roughconductor::RoughConductor;
 
 use crate::math::Rgb;
 use glam::{Vec2, Vec3};
+use params::Params;
 
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample {
@@ -32,19 +34,112 @@ pub struct BsdfSample {
     pub delta: bool,
 }
 
-/// Closed set of materials; enum dispatch keeps the hot path free of virtual calls.
-#[derive(Clone, Debug)]
-pub enum BsdfKind {
-    Diffuse(Diffuse),
-    Conductor(Conductor),
-    RoughConductor(RoughConductor),
-    Dielectric(Dielectric),
-    NoriMicrofacet(NoriMicrofacet),
-    Mirror(Mirror),
+/// A material model, one file each; `registry!` below lists them. In the local shading frame
+/// (z = shading normal), one-sided: `Material` mirrors the configuration for two-sided use.
+pub trait Bsdf: Sized {
+    /// Every lobe is a Dirac delta: `eval` and `pdf` are 0, `sample` gives the lobes.
+    const DELTA: bool;
+    /// Whether `twosided` may wrap it (not for a BSDF that gives both sides a meaning).
+    const TWO_SIDED: bool = true;
+    /// Reads Mitsuba's (or Nori's) parameters of its `<bsdf>` element.
+    fn from_params<P: Params>(p: &mut P) -> Result<Self, P::Error>;
+    /// f(wi, wo) |cos(wo)|.
+    fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb;
+    /// Solid-angle density of `sample`'s directions.
+    fn pdf(&self, wi: Vec3, wo: Vec3) -> f32;
+    /// `(eval, pdf)`, with the work they share done once where a BSDF can.
+    fn eval_pdf(&self, wi: Vec3, wo: Vec3) -> (Rgb, f32) {
+        (self.eval(wi, wo), self.pdf(wi, wo))
+    }
+    /// A direction with weight eval / pdf: `u1` picks a lobe, `u2` the direction within it.
+    fn sample(&self, wi: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample>;
+}
+
+/// The registration: one line per BSDF, `Variant(Type) = "scene type name"`. It makes the
+/// closed set `BsdfKind` (enum dispatch keeps the hot path free of virtual calls), its
+/// dispatch, the parser's table and `REGISTERED`, the list every per-BSDF test loops over.
+macro_rules! registry {
+    ($($variant:ident($ty:ty) = $name:literal;)*) => {
+        /// Closed set of materials, one variant per registered BSDF.
+        #[derive(Clone, Debug, PartialEq)]
+        pub enum BsdfKind {
+            $($variant($ty),)*
+        }
+
+        /// The scene type names of the registered BSDFs.
+        pub const REGISTERED: &[&str] = &[$($name,)*];
+
+        impl BsdfKind {
+            /// The BSDF of scene type `ty` from its parameters; None for a type not registered.
+            pub fn parse<P: Params>(ty: &str, p: &mut P) -> Option<Result<Self, P::Error>> {
+                match ty {
+                    $($name => Some(<$ty as Bsdf>::from_params(p).map(BsdfKind::$variant)),)*
+                    _ => None,
+                }
+            }
+
+            pub fn is_delta(&self) -> bool {
+                match self {
+                    $(BsdfKind::$variant(_) => <$ty as Bsdf>::DELTA,)*
+                }
+            }
+
+            /// Its scene type name.
+            pub fn type_name(&self) -> &'static str {
+                match self {
+                    $(BsdfKind::$variant(_) => $name,)*
+                }
+            }
+
+            /// Whether `twosided` may wrap it.
+            pub fn two_sided_ok(&self) -> bool {
+                match self {
+                    $(BsdfKind::$variant(_) => <$ty as Bsdf>::TWO_SIDED,)*
+                }
+            }
+
+            #[inline]
+            fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
+                match self {
+                    $(BsdfKind::$variant(b) => Bsdf::eval(b, wi, wo),)*
+                }
+            }
+
+            #[inline]
+            fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+                match self {
+                    $(BsdfKind::$variant(b) => Bsdf::pdf(b, wi, wo),)*
+                }
+            }
+
+            #[inline]
+            fn eval_pdf(&self, wi: Vec3, wo: Vec3) -> (Rgb, f32) {
+                match self {
+                    $(BsdfKind::$variant(b) => Bsdf::eval_pdf(b, wi, wo),)*
+                }
+            }
+
+            #[inline]
+            fn sample(&self, wi: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
+                match self {
+                    $(BsdfKind::$variant(b) => Bsdf::sample(b, wi, u1, u2),)*
+                }
+            }
+        }
+    };
+}
+
+registry! {
+    Diffuse(Diffuse) = "diffuse";
+    Conductor(Conductor) = "conductor";
+    RoughConductor(RoughConductor) = "roughconductor";
+    Dielectric(Dielectric) = "dielectric";
+    NoriMicrofacet(NoriMicrofacet) = "microfacet";
+    Mirror(Mirror) = "mirror";
 }
 
 /// A material: a BSDF and whether it is used on both sides of the surface.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     pub kind: BsdfKind,
     pub two_sided: bool,
@@ -63,49 +158,26 @@ impl Material {
 
     /// True if every lobe is a Dirac delta (light sampling is then useless).
     pub fn is_delta(&self) -> bool {
-        match &self.kind {
-            BsdfKind::Conductor(_) | BsdfKind::Dielectric(_) | BsdfKind::Mirror(_) => true,
-            BsdfKind::Diffuse(_) | BsdfKind::RoughConductor(_) | BsdfKind::NoriMicrofacet(_) => {
-                false
-            }
-        }
+        self.kind.is_delta()
     }
 
     #[inline]
     pub fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
         let (wi, wo) = self.orient(wi, wo);
-        match &self.kind {
-            BsdfKind::Diffuse(b) => b.eval(wi, wo),
-            BsdfKind::RoughConductor(b) => b.eval(wi, wo),
-            BsdfKind::NoriMicrofacet(b) => b.eval(wi, wo),
-            // Delta lobes have no density to evaluate.
-            BsdfKind::Conductor(_) | BsdfKind::Dielectric(_) | BsdfKind::Mirror(_) => Rgb::ZERO,
-        }
+        self.kind.eval(wi, wo)
     }
 
     #[inline]
     pub fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
         let (wi, wo) = self.orient(wi, wo);
-        match &self.kind {
-            BsdfKind::Diffuse(b) => b.pdf(wi, wo),
-            BsdfKind::RoughConductor(b) => b.pdf(wi, wo),
-            BsdfKind::NoriMicrofacet(b) => b.pdf(wi, wo),
-            BsdfKind::Conductor(_) | BsdfKind::Dielectric(_) | BsdfKind::Mirror(_) => 0.0,
-        }
+        self.kind.pdf(wi, wo)
     }
 
     /// `(eval, pdf)` with the work they share done once.
     #[inline]
     pub fn eval_pdf(&self, wi: Vec3, wo: Vec3) -> (Rgb, f32) {
         let (wi, wo) = self.orient(wi, wo);
-        match &self.kind {
-            BsdfKind::Diffuse(b) => (b.eval(wi, wo), b.pdf(wi, wo)),
-            BsdfKind::RoughConductor(b) => b.eval_pdf(wi, wo),
-            BsdfKind::NoriMicrofacet(b) => (b.eval(wi, wo), b.pdf(wi, wo)),
-            BsdfKind::Conductor(_) | BsdfKind::Dielectric(_) | BsdfKind::Mirror(_) => {
-                (Rgb::ZERO, 0.0)
-            }
-        }
+        self.kind.eval_pdf(wi, wo)
     }
 
     /// `u1` picks a lobe, `u2` the direction within it: separate numbers for separate decisions.
@@ -117,14 +189,7 @@ impl Material {
         } else {
             wi
         };
-        let mut s = match &self.kind {
-            BsdfKind::Diffuse(b) => b.sample(wi_up, u2)?,
-            BsdfKind::Conductor(b) => b.sample(wi_up)?,
-            BsdfKind::RoughConductor(b) => b.sample(wi_up, u2)?,
-            BsdfKind::Dielectric(b) => b.sample(wi_up, u1)?,
-            BsdfKind::NoriMicrofacet(b) => b.sample(wi_up, u1, u2)?,
-            BsdfKind::Mirror(b) => b.sample(wi_up)?,
-        };
+        let mut s = self.kind.sample(wi_up, u1, u2)?;
         if flip {
             s.wo.z = -s.wo.z;
         }

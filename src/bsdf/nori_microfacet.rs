@@ -8,13 +8,15 @@
 //! mixture ks D_true(h) cos_h / (4 |wo.h|) + (1 - ks) cos_o / π. One-sided.
 
 use super::fresnel::fresnel_dielectric;
+use super::params::{self, Params};
+use super::Bsdf;
 use super::BsdfSample;
 use crate::math::{Rgb, INV_PI};
 use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
 use crate::sampling::warps::square_to_cosine_hemisphere;
 use glam::{Vec2, Vec3};
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct NoriMicrofacet {
     mf: Microfacet,
     alpha: f32,
@@ -102,6 +104,35 @@ impl NoriMicrofacet {
             pdf,
             delta: false,
         })
+    }
+}
+
+impl Bsdf for NoriMicrofacet {
+    const DELTA: bool = false;
+
+    /// Nori's `alpha` (default 0.1), `intIOR`, `extIOR` and `kd` (default 0.5, at most 1).
+    fn from_params<P: Params>(p: &mut P) -> Result<Self, P::Error> {
+        let alpha = params::roughness(p, "alpha", 0.1)?;
+        let int_ior = params::ior(p, "int_ior", params::DEFAULT_INT_IOR)?;
+        let ext_ior = params::ior(p, "ext_ior", params::DEFAULT_EXT_IOR)?;
+        let kd = params::reflectance(p, "kd", Rgb::splat(0.5))?;
+        // ks = 1 - max(kd) is the specular lobe's selection probability.
+        if kd.max_element() > 1.0 {
+            return Err(p.error(
+                Some("kd"),
+                format!("microfacet kd must not exceed 1 (ks = 1 - max(kd)), found {kd}"),
+            ));
+        }
+        Ok(NoriMicrofacet::new(alpha, int_ior, ext_ior, kd))
+    }
+    fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
+        NoriMicrofacet::eval(self, wi, wo)
+    }
+    fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
+        NoriMicrofacet::pdf(self, wi, wo)
+    }
+    fn sample(&self, wi: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        NoriMicrofacet::sample(self, wi, u1, u2)
     }
 }
 

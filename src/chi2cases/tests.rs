@@ -194,3 +194,21 @@ fn narrowest_grazing_lobes_pass_at_ten_million_samples() {
         .collect();
     assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
+
+/// Registering a BSDF brings its chi-square cases with it: every registered type with a
+/// density (delta BSDFs have none to test) has at least one case among the BSDF materials.
+#[test]
+fn every_registered_bsdf_with_a_density_has_chi2_cases() {
+    let materials = super::bsdfs::materials();
+    for ty in crate::bsdf::REGISTERED {
+        let defaults = &mut crate::bsdf::params::Defaults;
+        let m = crate::bsdf::BsdfKind::parse(ty, defaults).unwrap().unwrap();
+        if m.is_delta() {
+            continue;
+        }
+        assert!(
+            materials.iter().any(|e| e.material.kind.type_name() == *ty),
+            "bsdf '{ty}' is registered but has no chi-square case in chi2cases/bsdfs.rs"
+        );
+    }
+}

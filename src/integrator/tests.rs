@@ -420,10 +420,11 @@ fn mis_variance_is_the_named_heuristics_with_its_sample_counts() {
 /// must be within 1e-6); one-sample MIS is z-tested (ALPHA, Sidak over all cases).
 #[test]
 fn delta_paths_at_sample_counts_two_and_three() {
-    use crate::scene::desc::{BsdfDesc, PointLightDesc};
+    use crate::bsdf::{BsdfKind, Mirror};
+    use crate::scene::desc::PointLightDesc;
     let radiance = 3.0f32;
     let mut mirror = fixtures::floor_probe(0.5, Vec3::ZERO, Vec3::new(0.0, -3.0, 3.0));
-    mirror.shapes[0].bsdf = BsdfDesc::Mirror;
+    mirror.shapes[0].bsdf = fixtures::one_sided(BsdfKind::Mirror(Mirror));
     // At z = 4, facing down: the mirrored camera ray, direction (0, 1, 1) / sqrt 2, meets it
     // at y = 4.
     mirror.shapes.push(fixtures::square_z(

@@ -12,7 +12,12 @@
 
 use super::elementary::{atan, exp, ln};
 use super::erf::{erfc_from_exp, erfinv};
-pub use crate::scene::desc::MicrofacetDistribution;
+/// The microfacet normal distributions Mitsuba's `roughconductor` offers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MicrofacetDistribution {
+    Beckmann,
+    Ggx,
+}
 use glam::{DVec3, Vec2, Vec3};
 use std::f32::consts::{FRAC_2_SQRT_PI, PI};
 

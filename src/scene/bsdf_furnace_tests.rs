@@ -1,4 +1,4 @@
-//! White furnace for every BSDF type the scene format registers (`SUPPORTED_BSDFS`): each is
+//! White furnace for every BSDF type the scene format registers (`supported_bsdfs`): each is
 //! read from XML as a user writes it, built as the renderer builds it, and must not create
 //! energy. A type without cases here fails the test, so a new BSDF gets its furnace too.
 //!
@@ -11,7 +11,7 @@
 //! - for materials with a density, the albedo by deterministic quadrature of `eval` (which
 //!   shares no code with the sampler) is at most 1 + 2e-3, and agrees with the sampled one.
 
-use super::bsdf::SUPPORTED_BSDFS;
+use super::bsdf::supported_bsdfs;
 use super::{load_scene_str, Scene};
 use crate::bsdf::fresnel::fresnel_dielectric;
 use crate::bsdf::{BsdfKind, Material};
@@ -185,7 +185,7 @@ fn incident() -> Vec<Vec3> {
 fn every_registered_bsdf_passes_the_white_furnace() {
     let n = 20_000;
     let mut report = Vec::new();
-    for ty in SUPPORTED_BSDFS {
+    for ty in supported_bsdfs() {
         let cases = cases(ty);
         assert!(!cases.is_empty(), "no white-furnace case for bsdf '{ty}'");
         for c in cases {
@@ -256,7 +256,7 @@ fn every_registered_bsdf_passes_the_white_furnace() {
 #[test]
 fn every_registered_bsdf_is_black_at_exactly_grazing_incidence() {
     let mut rng = Rng::new(5, 1);
-    for ty in SUPPORTED_BSDFS {
+    for ty in supported_bsdfs() {
         for c in cases(ty) {
             let mut m = material(&c.xml);
             for two_sided in [false, true] {

@@ -1,17 +1,14 @@
 //! From a `SceneDesc` to the renderer's runtime scene: materials, emitters, sampling tables
 //! and the BVH. Checks what only makes sense once geometry is known (degenerate emitters).
 
-use super::desc::{BsdfDesc, SceneDesc, ShapeGeometry};
-use crate::bsdf::{
-    BsdfKind, Conductor, Dielectric, Diffuse, Material, Mirror, NoriMicrofacet, RoughConductor,
-};
+use super::desc::{SceneDesc, ShapeGeometry};
+use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::emitter::{AreaLight, Emitter, LightSample, PointLight};
 use crate::geometry::{
     Accel, Hit, Mesh, PacketHits, Ray, RayPacket, Shape, ShapeKind, Sphere, SurfacePoint, NO_SKIP,
 };
 use crate::math::{offset_origin, Rgb};
-use crate::sampling::microfacet::Microfacet;
 use crate::sampling::AliasTable;
 use std::fmt;
 
@@ -79,105 +76,6 @@ fn check_rgb(origin: &str, what: &str, c: Rgb) -> Result<(), BuildError> {
     Ok(())
 }
 
-fn material(origin: &str, desc: &BsdfDesc, two_sided: bool) -> Result<Material, BuildError> {
-    let kind = match desc {
-        BsdfDesc::TwoSided(inner) => {
-            if matches!(**inner, BsdfDesc::TwoSided(_)) {
-                return Err(err(origin, "twosided cannot nest another twosided"));
-            }
-            return material(origin, inner, true);
-        }
-        BsdfDesc::Diffuse { reflectance } => {
-            check_rgb(origin, "diffuse reflectance", *reflectance)?;
-            BsdfKind::Diffuse(Diffuse {
-                reflectance: *reflectance,
-            })
-        }
-        BsdfDesc::Conductor {
-            eta,
-            k,
-            specular_reflectance,
-        } => {
-            check_rgb(origin, "conductor eta", *eta)?;
-            check_rgb(origin, "conductor k", *k)?;
-            check_rgb(origin, "specular_reflectance", *specular_reflectance)?;
-            BsdfKind::Conductor(Conductor {
-                eta: *eta,
-                k: *k,
-                specular_reflectance: *specular_reflectance,
-            })
-        }
-        BsdfDesc::RoughConductor {
-            distribution,
-            alpha_u,
-            alpha_v,
-            sample_visible,
-            eta,
-            k,
-            specular_reflectance,
-        } => {
-            check_rgb(origin, "roughconductor eta", *eta)?;
-            check_rgb(origin, "roughconductor k", *k)?;
-            check_rgb(origin, "specular_reflectance", *specular_reflectance)?;
-            check_positive(origin, "roughconductor alpha_u", *alpha_u)?;
-            check_positive(origin, "roughconductor alpha_v", *alpha_v)?;
-            BsdfKind::RoughConductor(RoughConductor {
-                mf: Microfacet::new(*distribution, *alpha_u, *alpha_v),
-                sample_visible: *sample_visible,
-                eta: *eta,
-                k: *k,
-                specular_reflectance: *specular_reflectance,
-            })
-        }
-        BsdfDesc::Dielectric { int_ior, ext_ior } => {
-            check_positive(origin, "dielectric int_ior", *int_ior)?;
-            check_positive(origin, "dielectric ext_ior", *ext_ior)?;
-            // As Mitsuba: the inside is meaningful, so mirroring it to the outside would turn
-            // refraction into nonsense.
-            if two_sided {
-                return Err(err(
-                    origin,
-                    "twosided cannot wrap a dielectric (it already handles both sides)",
-                ));
-            }
-            BsdfKind::Dielectric(Dielectric {
-                eta: int_ior / ext_ior,
-            })
-        }
-        BsdfDesc::NoriMicrofacet {
-            alpha,
-            int_ior,
-            ext_ior,
-            kd,
-        } => {
-            check_positive(origin, "microfacet alpha", *alpha)?;
-            check_positive(origin, "microfacet intIOR", *int_ior)?;
-            check_positive(origin, "microfacet extIOR", *ext_ior)?;
-            check_rgb(origin, "microfacet kd", *kd)?;
-            // ks = 1 - max(kd) is the specular lobe's selection probability.
-            if kd.max_element() > 1.0 {
-                return Err(err(
-                    origin,
-                    format!("microfacet kd must not exceed 1 (ks = 1 - max(kd)), found {kd}"),
-                ));
-            }
-            BsdfKind::NoriMicrofacet(NoriMicrofacet::new(*alpha, *int_ior, *ext_ior, *kd))
-        }
-        BsdfDesc::Mirror => BsdfKind::Mirror(Mirror),
-    };
-    Ok(Material { kind, two_sided })
-}
-
-fn check_positive(origin: &str, what: &str, x: f32) -> Result<(), BuildError> {
-    if !(x.is_finite() && x > 0.0) {
-        return Err(err(
-            origin,
-            format!("{what} must be finite and positive, found {x}"),
-        ));
-    }
-    Ok(())
-}
-
 /// Where a shadow ray from an origin to a target (at t = 1) stops: just short of the target.
 const SHADOW_TMAX: f32 = 1.0 - 1e-4;
 
@@ -191,7 +89,7 @@ impl Scene {
         for sd in &desc.shapes {
             let o = sd.origin.as_str();
             let shape_index = shapes.len() as u32;
-            materials.push(material(o, &sd.bsdf, false)?);
+            materials.push(sd.bsdf.clone());
             let kind = match &sd.geometry {
                 ShapeGeometry::Mesh {
                     positions,
@@ -457,92 +355,5 @@ impl Scene {
     pub fn emitter_at(&self, sp: &SurfacePoint) -> Option<(usize, &Emitter)> {
         let e = self.shapes[sp.shape as usize].emitter? as usize;
         Some((e, &self.emitters[e]))
-    }
-}
-
-#[cfg(test)]
-mod bsdf_material_tests {
-    //! `material()` for every BSDF kind: accepted parameters and rejected ones.
-    use super::*;
-    use crate::scene::desc::MicrofacetDistribution;
-
-    fn rough(alpha_u: f32) -> BsdfDesc {
-        BsdfDesc::RoughConductor {
-            distribution: MicrofacetDistribution::Ggx,
-            alpha_u,
-            alpha_v: 0.1,
-            sample_visible: true,
-            eta: Rgb::new(0.2, 0.9, 1.1),
-            k: Rgb::new(3.9, 2.4, 1.6),
-            specular_reflectance: Rgb::ONE,
-        }
-    }
-
-    #[test]
-    fn bsdf_kinds_build_and_flag_delta() {
-        let cases = [
-            (BsdfDesc::Mirror, true),
-            (
-                BsdfDesc::Conductor {
-                    eta: Rgb::ZERO,
-                    k: Rgb::ONE,
-                    specular_reflectance: Rgb::ONE,
-                },
-                true,
-            ),
-            (
-                BsdfDesc::Dielectric {
-                    int_ior: 1.5046,
-                    ext_ior: 1.000277,
-                },
-                true,
-            ),
-            (rough(0.3), false),
-            (
-                BsdfDesc::NoriMicrofacet {
-                    alpha: 0.1,
-                    int_ior: 1.5,
-                    ext_ior: 1.0,
-                    kd: Rgb::splat(0.3),
-                },
-                false,
-            ),
-        ];
-        for (d, delta) in cases {
-            let m = material("t", &d, false).unwrap();
-            assert_eq!(m.is_delta(), delta, "{d:?}");
-        }
-        let m = material("t", &BsdfDesc::TwoSided(Box::new(rough(0.2))), false).unwrap();
-        assert!(m.two_sided);
-    }
-
-    #[test]
-    fn bsdf_parameters_are_checked() {
-        let bad = [
-            rough(0.0),
-            rough(f32::NAN),
-            BsdfDesc::Dielectric {
-                int_ior: -1.5,
-                ext_ior: 1.0,
-            },
-            BsdfDesc::TwoSided(Box::new(BsdfDesc::Dielectric {
-                int_ior: 1.5,
-                ext_ior: 1.0,
-            })),
-            BsdfDesc::Conductor {
-                eta: Rgb::new(0.2, f32::INFINITY, 1.0),
-                k: Rgb::ONE,
-                specular_reflectance: Rgb::ONE,
-            },
-            BsdfDesc::NoriMicrofacet {
-                alpha: 0.1,
-                int_ior: 1.5,
-                ext_ior: 1.0,
-                kd: Rgb::new(1.2, 0.1, 0.1),
-            },
-        ];
-        for d in bad {
-            assert!(material("t", &d, false).is_err(), "{d:?}");
-        }
     }
 }

@@ -104,16 +104,19 @@ fn cornell_box_is_the_published_one() {
         }
     }
     assert_eq!(emitters, 1);
-    let white = BsdfDesc::Diffuse {
-        reflectance: Vec3::new(0.725, 0.71, 0.68),
-    };
-    let red = BsdfDesc::Diffuse {
-        reflectance: Vec3::new(0.63, 0.065, 0.05),
-    };
-    let green = BsdfDesc::Diffuse {
-        reflectance: Vec3::new(0.14, 0.45, 0.091),
-    };
-    let bsdfs: Vec<&BsdfDesc> = s.shapes.iter().map(|s| &s.bsdf).collect();
+    let white =
+        crate::scene::fixtures::one_sided(crate::bsdf::BsdfKind::Diffuse(crate::bsdf::Diffuse {
+            reflectance: Vec3::new(0.725, 0.71, 0.68),
+        }));
+    let red =
+        crate::scene::fixtures::one_sided(crate::bsdf::BsdfKind::Diffuse(crate::bsdf::Diffuse {
+            reflectance: Vec3::new(0.63, 0.065, 0.05),
+        }));
+    let green =
+        crate::scene::fixtures::one_sided(crate::bsdf::BsdfKind::Diffuse(crate::bsdf::Diffuse {
+            reflectance: Vec3::new(0.14, 0.45, 0.091),
+        }));
+    let bsdfs: Vec<&crate::bsdf::Material> = s.shapes.iter().map(|s| &s.bsdf).collect();
     assert_eq!(
         bsdfs,
         vec![&white, &white, &white, &red, &green, &white, &white, &white]
@@ -160,12 +163,7 @@ fn triangle_light_scene_matches_its_documentation() {
             .iter()
             .all(|p| p.y.abs() < 1e-6 && p.x.abs() <= 5.0 + 1e-5));
     }
-    assert_eq!(
-        s.shapes[0].bsdf,
-        BsdfDesc::Diffuse {
-            reflectance: Vec3::splat(0.5)
-        }
-    );
+    assert_eq!(s.shapes[0].bsdf, crate::scene::fixtures::diffuse(0.5));
     let light = &s.shapes[1];
     assert_eq!(
         light.emitter,

@@ -4,11 +4,11 @@
 //! renderer never needs to know which dialect a scene came from. `origin` strings name the file
 //! and line an element came from, so errors found later (degenerate emitters, ...) can point at it.
 
+use crate::bsdf::Material;
 use glam::{Mat4, Vec3};
 use std::path::PathBuf;
 
-/// Linear RGB triple used for colours, radiance and intensities.
-pub type Rgb = Vec3;
+pub use crate::math::Rgb;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneDesc {
@@ -130,51 +130,6 @@ pub struct IntegratorDesc {
     pub hide_emitters: bool,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MicrofacetDistribution {
-    Beckmann,
-    Ggx,
-}
-
-/// Materials as written in the scene. The renderer may reject ones it does not support yet.
-#[derive(Clone, Debug, PartialEq)]
-pub enum BsdfDesc {
-    Diffuse {
-        reflectance: Rgb,
-    },
-    /// Mitsuba `twosided`: the nested BSDF is used on both sides of the surface.
-    TwoSided(Box<BsdfDesc>),
-    /// Smooth conductor (Mitsuba `conductor`; Nori `mirror` is eta=0,k=0 with full reflectance
-    /// and is represented as `Mirror`).
-    Conductor {
-        eta: Rgb,
-        k: Rgb,
-        specular_reflectance: Rgb,
-    },
-    RoughConductor {
-        distribution: MicrofacetDistribution,
-        alpha_u: f32,
-        alpha_v: f32,
-        sample_visible: bool,
-        eta: Rgb,
-        k: Rgb,
-        specular_reflectance: Rgb,
-    },
-    Dielectric {
-        int_ior: f32,
-        ext_ior: f32,
-    },
-    /// Nori `microfacet`: diffuse kd plus a Beckmann specular lobe with ks = 1 - max(kd).
-    NoriMicrofacet {
-        alpha: f32,
-        int_ior: f32,
-        ext_ior: f32,
-        kd: Rgb,
-    },
-    /// Nori `mirror`: perfect specular reflection with reflectance 1.
-    Mirror,
-}
-
 #[derive(Clone, Debug, PartialEq)]
 pub enum ShapeGeometry {
     /// Triangle mesh in world space. `normals`, when present, has one entry per vertex.
@@ -200,7 +155,7 @@ pub struct AreaEmitterDesc {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ShapeDesc {
     pub geometry: ShapeGeometry,
-    pub bsdf: BsdfDesc,
+    pub bsdf: Material,
     pub emitter: Option<AreaEmitterDesc>,
     /// Where the shape was declared, as "file.xml:LINE <shape type=...>", for messages.
     pub origin: String,

@@ -2,6 +2,7 @@
 
 use super::desc::*;
 use super::mesh::TriMesh;
+use crate::bsdf::{BsdfKind, Diffuse, Material};
 use crate::math::look_at;
 use glam::{Mat4, Vec3};
 use std::path::PathBuf;
@@ -41,7 +42,7 @@ fn base(camera: Mat4, fov: f32, width: u32, height: u32, shapes: Vec<ShapeDesc>)
 pub fn mesh(
     positions: Vec<Vec3>,
     indices: Vec<[u32; 3]>,
-    bsdf: BsdfDesc,
+    bsdf: Material,
     radiance: Option<Rgb>,
 ) -> ShapeDesc {
     let m = TriMesh {
@@ -54,7 +55,7 @@ pub fn mesh(
 
 /// A shape of the triangle mesh `m` (with its vertex normals, if any), emitting `radiance`
 /// if given.
-pub fn tri_mesh(m: TriMesh, bsdf: BsdfDesc, radiance: Option<Rgb>, origin: &str) -> ShapeDesc {
+pub fn tri_mesh(m: TriMesh, bsdf: Material, radiance: Option<Rgb>, origin: &str) -> ShapeDesc {
     ShapeDesc {
         geometry: ShapeGeometry::Mesh {
             positions: m.positions,
@@ -68,7 +69,7 @@ pub fn tri_mesh(m: TriMesh, bsdf: BsdfDesc, radiance: Option<Rgb>, origin: &str)
 }
 
 /// A sphere shape, emitting `radiance` if given.
-pub fn sphere(center: Vec3, radius: f32, bsdf: BsdfDesc, radiance: Option<Rgb>) -> ShapeDesc {
+pub fn sphere(center: Vec3, radius: f32, bsdf: Material, radiance: Option<Rgb>) -> ShapeDesc {
     ShapeDesc {
         geometry: ShapeGeometry::Sphere {
             center,
@@ -81,14 +82,22 @@ pub fn sphere(center: Vec3, radius: f32, bsdf: BsdfDesc, radiance: Option<Rgb>) 
     }
 }
 
-pub fn diffuse(a: f32) -> BsdfDesc {
-    BsdfDesc::Diffuse {
+pub fn diffuse(a: f32) -> Material {
+    one_sided(BsdfKind::Diffuse(Diffuse {
         reflectance: Rgb::splat(a),
+    }))
+}
+
+/// `kind` on the front side only.
+pub fn one_sided(kind: BsdfKind) -> Material {
+    Material {
+        kind,
+        two_sided: false,
     }
 }
 
 /// The square [-half, half]^2 at height `z`, facing +z if `up`, else -z.
-pub fn square_z(half: f32, z: f32, up: bool, bsdf: BsdfDesc, radiance: Option<Rgb>) -> ShapeDesc {
+pub fn square_z(half: f32, z: f32, up: bool, bsdf: Material, radiance: Option<Rgb>) -> ShapeDesc {
     let s = half;
     let indices = if up {
         vec![[0, 1, 2], [0, 2, 3]]

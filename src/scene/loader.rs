@@ -10,6 +10,7 @@ use super::error::SceneError;
 use super::mesh::{self, TriMesh};
 use super::props::Plugin;
 use super::xml::{parse_document, Element};
+use crate::bsdf::{BsdfKind, Diffuse, Material};
 use glam::{Mat3, Mat4, Vec3};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -115,7 +116,7 @@ pub(super) struct Loader<'a> {
     pub(super) warnings: Vec<String>,
     /// Top-level BSDFs by id, parsed on first use so references may point forwards.
     pub(super) bsdf_elems: HashMap<String, &'a Element>,
-    pub(super) bsdfs: HashMap<String, BsdfDesc>,
+    pub(super) bsdfs: HashMap<String, Material>,
     pub(super) resolving: HashSet<String>,
 }
 
@@ -334,8 +335,11 @@ impl<'a> Loader<'a> {
         let bsdf = match p.nested_one(&["bsdf", "ref"])? {
             Some(b) if b.tag == "ref" => self.bsdf_ref(b)?,
             Some(b) => self.bsdf(b)?,
-            None => BsdfDesc::Diffuse {
-                reflectance: Vec3::splat(0.5),
+            None => Material {
+                kind: BsdfKind::Diffuse(Diffuse {
+                    reflectance: Vec3::splat(0.5),
+                }),
+                two_sided: false,
             },
         };
         let emitter = p

@@ -1,7 +1,67 @@
 //! Loader tests: each dialect's features, defaults and error messages.
 
 use super::*;
+use crate::bsdf::{
+    BsdfKind, Conductor, Dielectric, Diffuse, Material, Mirror, NoriMicrofacet, RoughConductor,
+};
+use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
 use crate::scene::transform;
+
+fn one(kind: BsdfKind) -> Material {
+    Material {
+        kind,
+        two_sided: false,
+    }
+}
+
+fn two(m: Material) -> Material {
+    Material {
+        two_sided: true,
+        ..m
+    }
+}
+
+fn diffuse(reflectance: Vec3) -> Material {
+    one(BsdfKind::Diffuse(Diffuse { reflectance }))
+}
+
+fn conductor(eta: Vec3, k: Vec3, specular_reflectance: Vec3) -> Material {
+    one(BsdfKind::Conductor(Conductor {
+        eta,
+        k,
+        specular_reflectance,
+    }))
+}
+
+fn rough(
+    d: MicrofacetDistribution,
+    alpha_u: f32,
+    alpha_v: f32,
+    sample_visible: bool,
+    eta: Vec3,
+    k: Vec3,
+    specular_reflectance: Vec3,
+) -> Material {
+    one(BsdfKind::RoughConductor(RoughConductor {
+        mf: Microfacet::new(d, alpha_u, alpha_v),
+        sample_visible,
+        eta,
+        k,
+        specular_reflectance,
+    }))
+}
+
+fn dielectric(int_ior: f32, ext_ior: f32) -> Material {
+    one(BsdfKind::Dielectric(Dielectric {
+        eta: int_ior / ext_ior,
+    }))
+}
+
+fn nori(alpha: f32, int_ior: f32, ext_ior: f32, kd: Vec3) -> Material {
+    one(BsdfKind::NoriMicrofacet(NoriMicrofacet::new(
+        alpha, int_ior, ext_ior, kd,
+    )))
+}
 
 const SENSOR: &str = r#"<sensor type="perspective"><float name="fov" value="45"/></sensor>"#;
 const LIGHT: &str = r#"<emitter type="point"><point name="position" value="0,5,0"/></emitter>"#;
@@ -21,7 +81,7 @@ fn m3_err(body: &str) -> String {
     load(&xml).unwrap_err().to_string()
 }
 
-fn shape_bsdf(s: &SceneDesc) -> &BsdfDesc {
+fn shape_bsdf(s: &SceneDesc) -> &Material {
     &s.shapes[0].bsdf
 }
 
@@ -213,15 +273,11 @@ fn refs_and_twosided() {
         <shape type="rectangle"/>
         <bsdf type="diffuse" id="red"><rgb name="reflectance" value="0.63, 0.065, 0.05"/></bsdf>
         <bsdf type="twosided" id="later"><bsdf type="diffuse"/></bsdf>"#);
-    let red = BsdfDesc::Diffuse {
-        reflectance: Vec3::new(0.63, 0.065, 0.05),
-    };
-    let grey = BsdfDesc::Diffuse {
-        reflectance: Vec3::splat(0.5),
-    };
-    assert_eq!(s.shapes[0].bsdf, BsdfDesc::TwoSided(Box::new(grey.clone())));
+    let red = diffuse(Vec3::new(0.63, 0.065, 0.05));
+    let grey = diffuse(Vec3::splat(0.5));
+    assert_eq!(s.shapes[0].bsdf, two(grey.clone()));
     assert_eq!(s.shapes[1].bsdf, red);
-    assert_eq!(s.shapes[2].bsdf, BsdfDesc::TwoSided(Box::new(red)));
+    assert_eq!(s.shapes[2].bsdf, two(red));
     assert_eq!(s.shapes[3].bsdf, grey);
 
     let e = m3_err(r#"<shape type="rectangle"><ref id="nope"/></shape>"#);
@@ -239,28 +295,20 @@ fn bsdf_parameters_and_defaults() {
         let s = m3(&format!(r#"<shape type="rectangle">{inner}</shape>"#));
         shape_bsdf(&s).clone()
     };
-    assert_eq!(
-        b(r#"<bsdf type="diffuse"/>"#),
-        BsdfDesc::Diffuse {
-            reflectance: Vec3::splat(0.5)
-        }
-    );
+    assert_eq!(b(r#"<bsdf type="diffuse"/>"#), diffuse(Vec3::splat(0.5)));
     assert_eq!(
         b(r#"<bsdf type="diffuse"><float name="reflectance" value="0.2"/></bsdf>"#),
-        BsdfDesc::Diffuse {
-            reflectance: Vec3::splat(0.2)
-        }
+        diffuse(Vec3::splat(0.2))
     );
     assert_eq!(
         b(r#"<bsdf type="conductor"/>"#),
-        BsdfDesc::Conductor {
-            eta: Vec3::ZERO,
-            k: Vec3::ONE,
-            specular_reflectance: Vec3::ONE
-        }
+        conductor(Vec3::ZERO, Vec3::ONE, Vec3::ONE)
     );
     match b(r#"<bsdf type="conductor"><string name="material" value="Au"/></bsdf>"#) {
-        BsdfDesc::Conductor { eta, k, .. } => {
+        Material {
+            kind: BsdfKind::Conductor(Conductor { eta, k, .. }),
+            ..
+        } => {
             assert!((eta.x - 0.143119).abs() < 1e-5 && (k.x - 3.98316).abs() < 1e-4);
         }
         other => panic!("{other:?}"),
@@ -270,67 +318,52 @@ fn bsdf_parameters_and_defaults() {
             r#"<bsdf type="conductor"><rgb name="eta" value="0.2"/><rgb name="k" value="3"/>
              <rgb name="specular_reflectance" value="0.9"/></bsdf>"#
         ),
-        BsdfDesc::Conductor {
-            eta: Vec3::splat(0.2),
-            k: Vec3::splat(3.0),
-            specular_reflectance: Vec3::splat(0.9)
-        }
+        conductor(Vec3::splat(0.2), Vec3::splat(3.0), Vec3::splat(0.9))
     );
     assert_eq!(
         b(r#"<bsdf type="roughconductor"/>"#),
-        BsdfDesc::RoughConductor {
-            distribution: MicrofacetDistribution::Beckmann,
-            alpha_u: 0.1,
-            alpha_v: 0.1,
-            sample_visible: true,
-            eta: Vec3::ZERO,
-            k: Vec3::ONE,
-            specular_reflectance: Vec3::ONE
-        }
+        rough(
+            MicrofacetDistribution::Beckmann,
+            0.1,
+            0.1,
+            true,
+            Vec3::ZERO,
+            Vec3::ONE,
+            Vec3::ONE
+        )
     );
     match b(
         r#"<bsdf type="roughconductor"><string name="distribution" value="ggx"/>
           <float name="alpha_u" value="0.05"/><float name="alpha_v" value="0.3"/>
           <boolean name="sample_visible" value="false"/><string name="material" value="Cu"/></bsdf>"#,
     ) {
-        BsdfDesc::RoughConductor {
-            distribution,
-            alpha_u,
-            alpha_v,
-            sample_visible,
+        Material {
+            kind: BsdfKind::RoughConductor(rc),
             ..
         } => {
-            assert_eq!(distribution, MicrofacetDistribution::Ggx);
-            assert_eq!((alpha_u, alpha_v, sample_visible), (0.05, 0.3, false));
+            assert_eq!(rc.mf.distribution, MicrofacetDistribution::Ggx);
+            let (au, av) = (rc.mf.alpha_u, rc.mf.alpha_v);
+            assert_eq!((au, av, rc.sample_visible), (0.05, 0.3, false));
         }
         other => panic!("{other:?}"),
     }
     assert_eq!(
         b(r#"<bsdf type="dielectric"/>"#),
-        BsdfDesc::Dielectric {
-            int_ior: 1.5046,
-            ext_ior: 1.000277
-        }
+        dielectric(1.5046, 1.000277)
     );
     assert_eq!(
         b(
             r#"<bsdf type="dielectric"><string name="int_ior" value="water"/>
              <float name="ext_ior" value="1.1"/></bsdf>"#
         ),
-        BsdfDesc::Dielectric {
-            int_ior: 1.333,
-            ext_ior: 1.1
-        }
+        dielectric(1.333, 1.1)
     );
     assert_eq!(
         b(
             r#"<bsdf type="dielectric"><string name="int_ior" value="diamond"/>
              <string name="ext_ior" value="vacuum"/></bsdf>"#
         ),
-        BsdfDesc::Dielectric {
-            int_ior: 2.419,
-            ext_ior: 1.0
-        }
+        dielectric(2.419, 1.0)
     );
 
     let e =
@@ -543,49 +576,23 @@ fn nori_scene() {
     let (p, n, _) = mesh(&s.shapes[0]);
     assert_eq!(p[1], Vec3::new(1.0, 0.0, 1.0));
     assert!(n.is_none());
-    assert_eq!(
-        s.shapes[0].bsdf,
-        BsdfDesc::Diffuse {
-            reflectance: Vec3::new(0.2, 0.3, 0.4)
-        }
-    );
+    assert_eq!(s.shapes[0].bsdf, diffuse(Vec3::new(0.2, 0.3, 0.4)));
     assert_eq!(
         s.shapes[0].emitter,
         Some(AreaEmitterDesc {
             radiance: Vec3::ONE
         })
     );
-    assert_eq!(
-        s.shapes[1].bsdf,
-        BsdfDesc::Diffuse {
-            reflectance: Vec3::splat(0.5)
-        }
-    );
-    assert_eq!(s.shapes[2].bsdf, BsdfDesc::Mirror);
-    assert_eq!(
-        s.shapes[3].bsdf,
-        BsdfDesc::Dielectric {
-            int_ior: 1.7,
-            ext_ior: 1.000277
-        }
-    );
+    assert_eq!(s.shapes[1].bsdf, diffuse(Vec3::splat(0.5)));
+    assert_eq!(s.shapes[2].bsdf, one(BsdfKind::Mirror(Mirror)));
+    assert_eq!(s.shapes[3].bsdf, dielectric(1.7, 1.000277));
     assert_eq!(
         s.shapes[4].bsdf,
-        BsdfDesc::NoriMicrofacet {
-            alpha: 0.1,
-            int_ior: 1.5046,
-            ext_ior: 1.000277,
-            kd: Vec3::splat(0.5)
-        }
+        nori(0.1, 1.5046, 1.000277, Vec3::splat(0.5))
     );
     assert_eq!(
         s.shapes[5].bsdf,
-        BsdfDesc::NoriMicrofacet {
-            alpha: 0.3,
-            int_ior: 1.3,
-            ext_ior: 1.1,
-            kd: Vec3::new(0.1, 0.2, 0.3)
-        }
+        nori(0.3, 1.3, 1.1, Vec3::new(0.1, 0.2, 0.3))
     );
     assert_eq!(s.point_lights[0].position, Vec3::new(1.0, 2.0, 3.0));
     assert!(s.point_lights[0].intensity.abs_diff_eq(Vec3::ONE, 1e-6));
@@ -708,14 +715,13 @@ fn mitsuba06_camel_case() {
     assert_eq!(s.sampler.sample_count, 9);
     assert_eq!((s.film.width, s.film.height), (20, 10));
     match shape_bsdf(&s) {
-        BsdfDesc::RoughConductor {
-            alpha_u,
-            alpha_v,
-            specular_reflectance,
-            sample_visible,
+        Material {
+            kind: BsdfKind::RoughConductor(rc),
             ..
         } => {
-            assert_eq!((*alpha_u, *alpha_v, *sample_visible), (0.2, 0.4, true));
+            let specular_reflectance = rc.specular_reflectance;
+            let (au, av) = (rc.mf.alpha_u, rc.mf.alpha_v);
+            assert_eq!((au, av, rc.sample_visible), (0.2, 0.4, true));
             // sRGB 128/255 is 0.2158 in linear
             assert!(
                 (specular_reflectance.x - 0.21586).abs() < 1e-4,
@@ -730,13 +736,7 @@ fn mitsuba06_camel_case() {
             radiance: Vec3::splat(3.0)
         })
     );
-    assert_eq!(
-        s.shapes[1].bsdf,
-        BsdfDesc::Dielectric {
-            int_ior: 1.4,
-            ext_ior: 1.000277
-        }
-    );
+    assert_eq!(s.shapes[1].bsdf, dielectric(1.4, 1.000277));
     let (_, n) = area_and_normal(&s.shapes[1]);
     assert!(n.abs_diff_eq(-Vec3::Z, 1e-6));
     assert!(mesh(&s.shapes[1]).1.is_none());

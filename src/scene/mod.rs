@@ -39,8 +39,6 @@ mod sensor;
 pub mod transform;
 pub mod xml;
 
-#[cfg(test)]
-pub(crate) use bsdf::METALS;
 pub use build::{BuildError, Scene};
 pub use error::SceneError;
 pub use loader::{load_scene, load_scene_str, Dialect};

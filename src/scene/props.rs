@@ -105,6 +105,11 @@ impl<'a> Plugin<'a> {
         Some(p)
     }
 
+    /// The element that gives parameter `key`, if it is given.
+    pub fn element_of(&self, key: &str) -> Option<&'a Element> {
+        self.props.iter().find(|p| p.name == key).map(|p| p.elem)
+    }
+
     pub fn has(&self, key: &'static str) -> bool {
         self.props.iter().any(|p| p.name == key)
     }

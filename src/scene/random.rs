@@ -10,8 +10,12 @@
 use super::desc::*;
 use super::fixtures::{diffuse, sphere, tri_mesh};
 use super::mesh::{cube, load_obj, TriMesh};
+use crate::bsdf::{
+    BsdfKind, Conductor, Dielectric, Diffuse, Material, Mirror, NoriMicrofacet, RoughConductor,
+};
 use crate::math::look_at;
 use crate::rng::Rng;
+use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
 use glam::{Mat4, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -66,7 +70,7 @@ impl Gen {
     }
 
     /// A material of every kind the format has, weighted towards those the lanes shade.
-    fn material(&mut self) -> (BsdfDesc, &'static str) {
+    fn material(&mut self) -> (Material, &'static str) {
         let rough = |g: &mut Gen, distribution, grey: bool| {
             let alpha_u = g.f(0.02, 0.9);
             let alpha_v = if g.chance(0.5) {
@@ -79,21 +83,19 @@ impl Gen {
             } else {
                 (g.rgb(0.1, 2.5), g.rgb(0.0, 5.0))
             };
-            BsdfDesc::RoughConductor {
-                distribution,
-                alpha_u,
-                alpha_v,
+            BsdfKind::RoughConductor(RoughConductor {
+                mf: Microfacet::new(distribution, alpha_u, alpha_v),
                 sample_visible: g.chance(0.85),
                 eta,
                 k,
                 specular_reflectance: g.rgb(0.3, 1.0),
-            }
+            })
         };
-        match self.below(20) {
+        let (kind, name) = match self.below(20) {
             0..=6 => (
-                BsdfDesc::Diffuse {
+                BsdfKind::Diffuse(Diffuse {
                     reflectance: self.rgb(0.0, 0.95),
-                },
+                }),
                 "diffuse",
             ),
             7..=11 => (
@@ -105,38 +107,50 @@ impl Gen {
                 rough(self, MicrofacetDistribution::Beckmann, false),
                 "rough-coloured",
             ),
-            14 => (
-                BsdfDesc::TwoSided(Box::new(BsdfDesc::Diffuse {
+            14 => {
+                let kind = BsdfKind::Diffuse(Diffuse {
                     reflectance: self.rgb(0.0, 0.95),
-                })),
-                "twosided",
-            ),
+                });
+                return (
+                    Material {
+                        kind,
+                        two_sided: true,
+                    },
+                    "twosided",
+                );
+            }
             15 => (
-                BsdfDesc::Conductor {
+                BsdfKind::Conductor(Conductor {
                     eta: self.rgb(0.1, 2.5),
                     k: self.rgb(0.0, 5.0),
                     specular_reflectance: Rgb::ONE,
-                },
+                }),
                 "conductor",
             ),
             16 => (
-                BsdfDesc::Dielectric {
-                    int_ior: self.f(1.1, 2.0),
-                    ext_ior: 1.0,
-                },
+                BsdfKind::Dielectric(Dielectric {
+                    eta: self.f(1.1, 2.0),
+                }),
                 "dielectric",
             ),
-            17 => (BsdfDesc::Mirror, "mirror"),
+            17 => (BsdfKind::Mirror(Mirror), "mirror"),
             _ => (
-                BsdfDesc::NoriMicrofacet {
-                    alpha: self.f(0.05, 0.6),
-                    int_ior: self.f(1.2, 1.8),
-                    ext_ior: 1.0,
-                    kd: self.rgb(0.0, 0.5),
-                },
+                BsdfKind::NoriMicrofacet(NoriMicrofacet::new(
+                    self.f(0.05, 0.6),
+                    self.f(1.2, 1.8),
+                    1.0,
+                    self.rgb(0.0, 0.5),
+                )),
                 "nori-microfacet",
             ),
-        }
+        };
+        (
+            Material {
+                kind,
+                two_sided: false,
+            },
+            name,
+        )
     }
 
     /// Writes `m` as an OBJ file with its vertex normals and reads it back as a user's mesh

@@ -7,11 +7,12 @@
 
 use crate::analytic::polygon_irradiance;
 use crate::bsdf::fresnel::{fresnel_conductor, fresnel_dielectric};
+use crate::bsdf::BsdfKind;
 use crate::bsdf::Material;
 use crate::experiment::cases::ClosedForm;
 use crate::geometry::Ray;
 use crate::math::Frame;
-use crate::scene::desc::{BsdfDesc, SceneDesc, ShapeGeometry};
+use crate::scene::desc::{SceneDesc, ShapeGeometry};
 use crate::scene::Scene;
 use glam::{DVec3, Vec3};
 
@@ -59,15 +60,13 @@ fn receiver(scene: &Scene) -> Result<Receiver, String> {
 pub fn evaluate(scene: &Scene, form: ClosedForm) -> Result<f64, String> {
     let r = receiver(scene)?;
     let bsdf = &scene.desc.shapes[r.shape].bsdf;
-    let inner = match bsdf {
-        BsdfDesc::TwoSided(b) => b.as_ref(),
-        b => b,
-    };
+    let inner = &bsdf.kind;
     match form {
         ClosedForm::Lambert => {
-            let BsdfDesc::Diffuse { reflectance } = inner else {
+            let BsdfKind::Diffuse(d) = inner else {
                 return Err(format!("lambert needs a diffuse receiver, found {bsdf:?}"));
             };
+            let reflectance = d.reflectance;
             let e = lambert_irradiance(&scene.desc, r.x, r.n)?;
             Ok(reflectance.x as f64 / std::f64::consts::PI * e)
         }
@@ -75,20 +74,13 @@ pub fn evaluate(scene: &Scene, form: ClosedForm) -> Result<f64, String> {
             let wo = (r.eye - r.x).normalize();
             let cos = wo.dot(r.n);
             let f = match inner {
-                BsdfDesc::Conductor {
-                    eta,
-                    k,
-                    specular_reflectance,
+                BsdfKind::Conductor(c) => {
+                    (fresnel_conductor(cos, c.eta, c.k) * c.specular_reflectance).x
                 }
-                | BsdfDesc::RoughConductor {
-                    eta,
-                    k,
-                    specular_reflectance,
-                    ..
-                } => (fresnel_conductor(cos, *eta, *k) * *specular_reflectance).x,
-                BsdfDesc::Dielectric { int_ior, ext_ior } => {
-                    fresnel_dielectric(cos, int_ior / ext_ior).0
+                BsdfKind::RoughConductor(c) => {
+                    (fresnel_conductor(cos, c.eta, c.k) * c.specular_reflectance).x
                 }
+                BsdfKind::Dielectric(d) => fresnel_dielectric(cos, d.eta).0,
                 b => {
                     return Err(format!(
                         "fresnel needs a conductor or dielectric, found {b:?}"
