@@ -458,6 +458,12 @@ pub(super) fn similarity_scale(m: &Mat4) -> Option<f32> {
 }
 
 #[cfg(test)]
+#[path = "loader_bsdf_tests.rs"]
+mod bsdf_tests;
+#[cfg(test)]
+#[path = "loader_nori_tests.rs"]
+mod nori_tests;
+#[cfg(test)]
 #[path = "loader_tests.rs"]
 mod tests;
 

@@ -1,91 +1,34 @@
 //! Loader tests: each dialect's features, defaults and error messages.
 
+use super::bsdf_tests::dielectric;
 use super::*;
-use crate::bsdf::{
-    BsdfKind, Conductor, Dielectric, Diffuse, Material, Mirror, NoriMicrofacet, RoughConductor,
-};
-use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
-use crate::scene::transform;
+use crate::bsdf::{BsdfKind, Material};
 
-fn one(kind: BsdfKind) -> Material {
-    Material {
-        kind,
-        two_sided: false,
-    }
-}
+pub(super) const SENSOR: &str =
+    r#"<sensor type="perspective"><float name="fov" value="45"/></sensor>"#;
+pub(super) const LIGHT: &str =
+    r#"<emitter type="point"><point name="position" value="0,5,0"/></emitter>"#;
 
-fn two(m: Material) -> Material {
-    Material {
-        two_sided: true,
-        ..m
-    }
-}
-
-fn diffuse(reflectance: Vec3) -> Material {
-    one(BsdfKind::Diffuse(Diffuse { reflectance }))
-}
-
-fn conductor(eta: Vec3, k: Vec3, specular_reflectance: Vec3) -> Material {
-    one(BsdfKind::Conductor(Conductor {
-        eta,
-        k,
-        specular_reflectance,
-    }))
-}
-
-fn rough(
-    d: MicrofacetDistribution,
-    alpha_u: f32,
-    alpha_v: f32,
-    sample_visible: bool,
-    eta: Vec3,
-    k: Vec3,
-    specular_reflectance: Vec3,
-) -> Material {
-    one(BsdfKind::RoughConductor(RoughConductor {
-        mf: Microfacet::new(d, alpha_u, alpha_v),
-        sample_visible,
-        eta,
-        k,
-        specular_reflectance,
-    }))
-}
-
-fn dielectric(int_ior: f32, ext_ior: f32) -> Material {
-    one(BsdfKind::Dielectric(Dielectric {
-        eta: int_ior / ext_ior,
-    }))
-}
-
-fn nori(alpha: f32, int_ior: f32, ext_ior: f32, kd: Vec3) -> Material {
-    one(BsdfKind::NoriMicrofacet(NoriMicrofacet::new(
-        alpha, int_ior, ext_ior, kd,
-    )))
-}
-
-const SENSOR: &str = r#"<sensor type="perspective"><float name="fov" value="45"/></sensor>"#;
-const LIGHT: &str = r#"<emitter type="point"><point name="position" value="0,5,0"/></emitter>"#;
-
-fn load(xml: &str) -> Result<SceneDesc, SceneError> {
+pub(super) fn load(xml: &str) -> Result<SceneDesc, SceneError> {
     load_scene_str(xml, Path::new("dir/test.xml"), &[])
 }
 
 /// A Mitsuba 3 scene with a sensor and a point light around `body`.
-fn m3(body: &str) -> SceneDesc {
+pub(super) fn m3(body: &str) -> SceneDesc {
     let xml = format!("<scene version=\"3.0.0\">{SENSOR}{LIGHT}{body}</scene>");
     load(&xml).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn m3_err(body: &str) -> String {
+pub(super) fn m3_err(body: &str) -> String {
     let xml = format!("<scene version=\"3.0.0\">{SENSOR}{LIGHT}\n{body}\n</scene>");
     load(&xml).unwrap_err().to_string()
 }
 
-fn shape_bsdf(s: &SceneDesc) -> &Material {
+pub(super) fn shape_bsdf(s: &SceneDesc) -> &Material {
     &s.shapes[0].bsdf
 }
 
-fn mesh(s: &ShapeDesc) -> (&Vec<Vec3>, &Option<Vec<Vec3>>, &Vec<[u32; 3]>) {
+pub(super) fn mesh(s: &ShapeDesc) -> (&Vec<Vec3>, &Option<Vec<Vec3>>, &Vec<[u32; 3]>) {
     match &s.geometry {
         ShapeGeometry::Mesh {
             positions,
@@ -265,141 +208,6 @@ fn defaults_and_defines() {
 }
 
 #[test]
-fn refs_and_twosided() {
-    let s = m3(r#"
-        <shape type="rectangle"><ref id="later"/></shape>
-        <shape type="rectangle"><ref name="bsdf" id="red"/></shape>
-        <shape type="rectangle"><bsdf type="twosided"><ref id="red"/></bsdf></shape>
-        <shape type="rectangle"/>
-        <bsdf type="diffuse" id="red"><rgb name="reflectance" value="0.63, 0.065, 0.05"/></bsdf>
-        <bsdf type="twosided" id="later"><bsdf type="diffuse"/></bsdf>"#);
-    let red = diffuse(Vec3::new(0.63, 0.065, 0.05));
-    let grey = diffuse(Vec3::splat(0.5));
-    assert_eq!(s.shapes[0].bsdf, two(grey.clone()));
-    assert_eq!(s.shapes[1].bsdf, red);
-    assert_eq!(s.shapes[2].bsdf, two(red));
-    assert_eq!(s.shapes[3].bsdf, grey);
-
-    let e = m3_err(r#"<shape type="rectangle"><ref id="nope"/></shape>"#);
-    assert!(
-        e.contains("test.xml:2: <ref id=\"nope\">: no top-level <bsdf> has id 'nope'"),
-        "{e}"
-    );
-    let e = m3_err(r#"<bsdf type="twosided" id="a"><ref id="a"/></bsdf>"#);
-    assert!(e.contains("refers to itself"), "{e}");
-}
-
-#[test]
-fn bsdf_parameters_and_defaults() {
-    let b = |inner: &str| {
-        let s = m3(&format!(r#"<shape type="rectangle">{inner}</shape>"#));
-        shape_bsdf(&s).clone()
-    };
-    assert_eq!(b(r#"<bsdf type="diffuse"/>"#), diffuse(Vec3::splat(0.5)));
-    assert_eq!(
-        b(r#"<bsdf type="diffuse"><float name="reflectance" value="0.2"/></bsdf>"#),
-        diffuse(Vec3::splat(0.2))
-    );
-    assert_eq!(
-        b(r#"<bsdf type="conductor"/>"#),
-        conductor(Vec3::ZERO, Vec3::ONE, Vec3::ONE)
-    );
-    match b(r#"<bsdf type="conductor"><string name="material" value="Au"/></bsdf>"#) {
-        Material {
-            kind: BsdfKind::Conductor(Conductor { eta, k, .. }),
-            ..
-        } => {
-            assert!((eta.x - 0.143119).abs() < 1e-5 && (k.x - 3.98316).abs() < 1e-4);
-        }
-        other => panic!("{other:?}"),
-    }
-    assert_eq!(
-        b(
-            r#"<bsdf type="conductor"><rgb name="eta" value="0.2"/><rgb name="k" value="3"/>
-             <rgb name="specular_reflectance" value="0.9"/></bsdf>"#
-        ),
-        conductor(Vec3::splat(0.2), Vec3::splat(3.0), Vec3::splat(0.9))
-    );
-    assert_eq!(
-        b(r#"<bsdf type="roughconductor"/>"#),
-        rough(
-            MicrofacetDistribution::Beckmann,
-            0.1,
-            0.1,
-            true,
-            Vec3::ZERO,
-            Vec3::ONE,
-            Vec3::ONE
-        )
-    );
-    match b(
-        r#"<bsdf type="roughconductor"><string name="distribution" value="ggx"/>
-          <float name="alpha_u" value="0.05"/><float name="alpha_v" value="0.3"/>
-          <boolean name="sample_visible" value="false"/><string name="material" value="Cu"/></bsdf>"#,
-    ) {
-        Material {
-            kind: BsdfKind::RoughConductor(rc),
-            ..
-        } => {
-            assert_eq!(rc.mf.distribution, MicrofacetDistribution::Ggx);
-            let (au, av) = (rc.mf.alpha_u, rc.mf.alpha_v);
-            assert_eq!((au, av, rc.sample_visible), (0.05, 0.3, false));
-        }
-        other => panic!("{other:?}"),
-    }
-    assert_eq!(
-        b(r#"<bsdf type="dielectric"/>"#),
-        dielectric(1.5046, 1.000277)
-    );
-    assert_eq!(
-        b(
-            r#"<bsdf type="dielectric"><string name="int_ior" value="water"/>
-             <float name="ext_ior" value="1.1"/></bsdf>"#
-        ),
-        dielectric(1.333, 1.1)
-    );
-    assert_eq!(
-        b(
-            r#"<bsdf type="dielectric"><string name="int_ior" value="diamond"/>
-             <string name="ext_ior" value="vacuum"/></bsdf>"#
-        ),
-        dielectric(2.419, 1.0)
-    );
-
-    let e =
-        m3_err(r#"<bsdf type="dielectric" id="g"><string name="int_ior" value="glassy"/></bsdf>"#);
-    assert!(e.contains("unknown IOR name \"glassy\""), "{e}");
-    let e = m3_err(
-        r#"<bsdf type="roughconductor" id="r"><float name="alpha" value="0.1"/><float name="alpha_u" value="0.1"/></bsdf>"#,
-    );
-    assert!(e.contains("not both"), "{e}");
-    let e = m3_err(
-        r#"<bsdf type="conductor" id="c"><string name="material" value="Unobtainium"/></bsdf>"#,
-    );
-    assert!(e.contains("not supported yet"), "{e}");
-    for (eta, k) in [("-0.2", "3"), ("0.2", "1e7"), ("0.2", "1, 2, -3")] {
-        let e = m3_err(&format!(
-            r#"<bsdf type="roughconductor" id="c"><rgb name="eta" value="{eta}"/><rgb name="k" value="{k}"/></bsdf>"#
-        ));
-        assert!(
-            e.contains("test.xml:2: <bsdf type=\"roughconductor\" id=\"c\">: conductor ")
-                && e.contains("must lie in [0, 1e6] in every channel"),
-            "{e}"
-        );
-    }
-    let e = m3_err(r#"<bsdf type="plastic" id="p"/>"#);
-    assert!(
-        e.contains(
-            "test.xml:2: <bsdf type=\"plastic\" id=\"p\">: bsdf 'plastic' is not supported yet"
-        ),
-        "{e}"
-    );
-    let e =
-        m3_err(r#"<bsdf type="diffuse" id="d"><texture type="bitmap" name="reflectance"/></bsdf>"#);
-    assert!(e.contains("texture 'bitmap' is not supported yet"), "{e}");
-}
-
-#[test]
 fn rectangle_cube_sphere() {
     let s = m3(r#"
         <shape type="rectangle">
@@ -517,163 +325,6 @@ fn area_emitters_and_point_lights() {
     );
     let e = m3_err(r#"<emitter type="constant"/>"#);
     assert!(e.contains("not supported yet"), "{e}");
-}
-
-#[test]
-fn nori_scene() {
-    let dir = TempDir::new("nori");
-    dir.write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-    let xml = r#"<?xml version="1.0"?>
-<scene>
-    <integrator type="direct"><string name="sampling" value="light"/></integrator>
-    <sampler type="independent"><integer name="sampleCount" value="32"/></sampler>
-    <camera type="perspective">
-        <float name="fov" value="30"/>
-        <integer name="width" value="100"/>
-        <integer name="height" value="50"/>
-        <float name="nearClip" value="0.1"/>
-        <transform name="toWorld">
-            <scale value="-1,1,1"/>
-            <lookat target="0,0,0" origin="0,0,5" up="0,1,0"/>
-        </transform>
-    </camera>
-    <mesh type="obj">
-        <string name="filename" value="tri.obj"/>
-        <transform name="toWorld"><translate value="0,0,1"/></transform>
-        <bsdf type="diffuse"><color name="albedo" value="0.2 0.3 0.4"/></bsdf>
-        <emitter type="area"><color name="radiance" value="1,1,1"/></emitter>
-    </mesh>
-    <mesh type="obj"><string name="filename" value="tri.obj"/></mesh>
-    <mesh type="obj"><string name="filename" value="tri.obj"/><bsdf type="mirror"/></mesh>
-    <mesh type="obj"><string name="filename" value="tri.obj"/>
-        <bsdf type="dielectric"><float name="intIOR" value="1.7"/></bsdf></mesh>
-    <mesh type="obj"><string name="filename" value="tri.obj"/><bsdf type="microfacet"/></mesh>
-    <mesh type="obj"><string name="filename" value="tri.obj"/>
-        <bsdf type="microfacet"><float name="alpha" value="0.3"/><float name="intIOR" value="1.3"/>
-        <float name="extIOR" value="1.1"/><color name="kd" value="0.1, 0.2, 0.3"/></bsdf></mesh>
-    <emitter type="point"><point name="position" value="1,2,3"/><color name="power" value="12.566370614"/></emitter>
-    <emitter type="pointlight"><point name="position" value="0,1,0"/><color name="radiance" value="2,2,2"/></emitter>
-</scene>"#;
-    let path = dir.write("scene.xml", xml);
-    let s = load_scene(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(s.integrator.strategy, StrategyKind::Light);
-    assert_eq!(s.sampler.sample_count, 32);
-    assert_eq!((s.film.width, s.film.height), (100, 50));
-    assert_eq!(
-        s.film.filter,
-        FilterDesc::Gaussian {
-            stddev: 0.5,
-            radius: 2.0
-        }
-    );
-    assert_eq!(
-        (s.camera.fov_degrees, s.camera.near_clip, s.camera.far_clip),
-        (30.0, 0.1, 10000.0)
-    );
-    let expected = transform::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Some(Vec3::Y)).unwrap()
-        * Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0));
-    assert!(s.camera.to_world.abs_diff_eq(expected, 1e-6));
-    let (p, n, _) = mesh(&s.shapes[0]);
-    assert_eq!(p[1], Vec3::new(1.0, 0.0, 1.0));
-    assert!(n.is_none());
-    assert_eq!(s.shapes[0].bsdf, diffuse(Vec3::new(0.2, 0.3, 0.4)));
-    assert_eq!(
-        s.shapes[0].emitter,
-        Some(AreaEmitterDesc {
-            radiance: Vec3::ONE
-        })
-    );
-    assert_eq!(s.shapes[1].bsdf, diffuse(Vec3::splat(0.5)));
-    assert_eq!(s.shapes[2].bsdf, one(BsdfKind::Mirror(Mirror)));
-    assert_eq!(s.shapes[3].bsdf, dielectric(1.7, 1.000277));
-    assert_eq!(
-        s.shapes[4].bsdf,
-        nori(0.1, 1.5046, 1.000277, Vec3::splat(0.5))
-    );
-    assert_eq!(
-        s.shapes[5].bsdf,
-        nori(0.3, 1.3, 1.1, Vec3::new(0.1, 0.2, 0.3))
-    );
-    assert_eq!(s.point_lights[0].position, Vec3::new(1.0, 2.0, 3.0));
-    assert!(s.point_lights[0].intensity.abs_diff_eq(Vec3::ONE, 1e-6));
-    assert_eq!(s.point_lights[1].intensity, Vec3::splat(2.0));
-}
-
-#[test]
-fn nori_defaults_and_sampling_values() {
-    let scene = |integrator: &str| {
-        format!(
-            r#"<scene>{integrator}<camera type="perspective"/>
-            <emitter type="pointlight"><point name="position" value="0,1,0"/><color name="radiance" value="1"/></emitter></scene>"#
-        )
-    };
-    let s = load(&scene("")).unwrap();
-    assert_eq!(
-        (s.film.width, s.film.height, s.sampler.sample_count),
-        (1280, 720, 1)
-    );
-    assert_eq!((s.camera.fov_degrees, s.camera.near_clip), (30.0, 1e-4));
-    let cases = [
-        (
-            r#"<integrator type="direct"><string name="sampling" value="light"/></integrator>"#,
-            StrategyKind::Light,
-            Heuristic::Balance,
-        ),
-        (
-            r#"<integrator type="direct"><string name="sampling" value="material"/></integrator>"#,
-            StrategyKind::Bsdf,
-            Heuristic::Balance,
-        ),
-        (
-            r#"<integrator type="direct"><string name="sampling" value="MIS"/></integrator>"#,
-            StrategyKind::Mis,
-            Heuristic::Balance,
-        ),
-        (
-            r#"<integrator type="direct"><string name="sampling" value="mis"/></integrator>"#,
-            StrategyKind::Mis,
-            Heuristic::Balance,
-        ),
-        (
-            r#"<integrator type="direct_ems"/>"#,
-            StrategyKind::Light,
-            Heuristic::Balance,
-        ),
-        (
-            r#"<integrator type="direct_mats"/>"#,
-            StrategyKind::Bsdf,
-            Heuristic::Balance,
-        ),
-        (
-            r#"<integrator type="direct_mis"/>"#,
-            StrategyKind::Mis,
-            Heuristic::Balance,
-        ),
-    ];
-    for (integrator, strategy, heuristic) in cases {
-        let s = load(&scene(integrator)).unwrap();
-        assert_eq!(
-            (s.integrator.strategy, s.integrator.heuristic),
-            (strategy, heuristic),
-            "{integrator}"
-        );
-    }
-    let e = load(&scene(
-        r#"<integrator type="direct"><string name="sampling" value="both"/></integrator>"#,
-    ))
-    .unwrap_err()
-    .to_string();
-    assert!(
-        e.contains("expected sampling \"light\", \"material\" or \"MIS\""),
-        "{e}"
-    );
-    let e = load(&scene(r#"<integrator type="path_mis"/>"#))
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("only direct illumination is supported; found integrator 'path_mis'"),
-        "{e}"
-    );
 }
 
 #[test]
