@@ -229,4 +229,25 @@ mod tests {
             }
         }
     }
+
+    /// The grey shortcut is taken exactly when all three channels of eta and of k agree:
+    /// indices that agree in some channels only (each of the 16 patterns of which of
+    /// eta.y, eta.z, k.y, k.z equal the x channel) keep their colour.
+    #[test]
+    fn grey_exactly_when_every_channel_agrees() {
+        for pattern in 0..16u32 {
+            let same = |bit: u32| pattern >> bit & 1 != 0;
+            let pick = |bit: u32, x: f32, other: f32| if same(bit) { x } else { other };
+            let eta = Rgb::new(0.2, pick(0, 0.2, 0.9), pick(1, 0.2, 1.3));
+            let k = Rgb::new(3.0, pick(2, 3.0, 2.1), pick(3, 3.0, 1.7));
+            assert_eq!(is_grey(eta, k), pattern == 15, "{eta} {k}");
+            for c in [0.05f32, 0.5, 1.0] {
+                let f = fresnel_conductor(c, eta, k);
+                for ch in 0..3 {
+                    let one = fresnel_conductor(c, Rgb::splat(eta[ch]), Rgb::splat(k[ch]));
+                    assert_eq!(f[ch], one.x, "{eta} {k} cos {c} channel {ch}");
+                }
+            }
+        }
+    }
 }
