@@ -278,6 +278,165 @@ impl Gen {
 }
 
 /// The scene of `seed`. Its OBJ files are written under `dir`.
+impl Gen {
+    /// A floor under everything, so most pixels see a receiver, and one to four objects.
+    fn receivers(&mut self, f: &mut Features, shapes: &mut Vec<ShapeDesc>) {
+        let (bsdf, name) = self.material();
+        f.materials.push(name);
+        let floor = match self.chance(0.5) {
+            true => {
+                f.smooth_receivers += 1;
+                self.bumpy_floor(3.0)
+            }
+            false => {
+                let mut m = super::mesh::rectangle();
+                m.transform(&Mat4::from_scale(Vec3::splat(3.0)));
+                m
+            }
+        };
+        shapes.push(tri_mesh(floor, bsdf, None, "<random floor>"));
+
+        for _ in 0..1 + self.below(4) {
+            let (bsdf, name) = self.material();
+            f.materials.push(name);
+            let c = Vec3::new(self.f(-1.5, 1.5), self.f(-1.5, 1.5), self.f(0.3, 1.2));
+            let r = self.f(0.15, 0.6);
+            shapes.push(match self.below(4) {
+                0 => {
+                    f.smooth_receivers += 1;
+                    let m = self.uv_sphere(c, r);
+                    tri_mesh(m, bsdf, None, "<random smooth sphere>")
+                }
+                1 => sphere(c, r, bsdf, None),
+                2 => {
+                    let mut m = cube();
+                    m.transform(&(Mat4::from_translation(c) * Mat4::from_scale(Vec3::splat(r))));
+                    tri_mesh(m, bsdf, None, "<random cube>")
+                }
+                _ => {
+                    let v = [self.unit(), self.unit(), self.unit()].map(|d| c + 2.0 * r * d);
+                    tri_mesh(
+                        TriMesh {
+                            positions: v.to_vec(),
+                            normals: None,
+                            indices: vec![[0, 1, 2]],
+                        },
+                        bsdf,
+                        None,
+                        "<random triangle>",
+                    )
+                }
+            });
+        }
+    }
+
+    /// One to ten lights: the lanes' small tables hold up to eight emitters and up to eight
+    /// triangles per mesh, so both sides of each limit come up.
+    fn lights(&mut self, f: &mut Features, shapes: &mut Vec<ShapeDesc>) {
+        let lights = match self.chance(0.75) {
+            true => 1 + self.below(4),
+            false => 5 + self.below(6),
+        };
+        for _ in 0..lights {
+            let c = Vec3::new(self.f(-2.5, 2.5), self.f(-2.5, 2.5), self.f(1.5, 3.5));
+            let radiance = self.rgb(0.5, 8.0);
+            // Emitters reflect as well, now and then.
+            let bsdf = match self.chance(0.3) {
+                true => self.material().0,
+                false => diffuse(0.0),
+            };
+            if self.chance(0.3) {
+                f.lights.push("sphere");
+                shapes.push(sphere(c, self.f(0.05, 0.4), bsdf, Some(radiance)));
+                continue;
+            }
+            // Mostly facing down towards the scene, sometimes away (one-sided: dark from below).
+            let towards = (Vec3::new(self.f(-1.0, 1.0), self.f(-1.0, 1.0), 0.0) - c).normalize();
+            let normal = match self.chance(0.85) {
+                true => (towards + 0.4 * self.unit()).normalize(),
+                false => self.unit(),
+            };
+            let n = match self.chance(0.6) {
+                true => 1 + self.below(8),
+                false => 9 + self.below(12),
+            };
+            let r = self.f(0.1, 0.6);
+            let mut m = self.fan(c, normal, r, n);
+            f.lights.push(if n > 8 { "mesh-big" } else { "mesh" });
+            if self.chance(0.3) {
+                f.lights.push("mesh-smooth");
+                m.normals = Some(
+                    m.positions
+                        .iter()
+                        .map(|&p| (normal + 0.5 * (p - c)).normalize())
+                        .collect(),
+                );
+                m = self.through_obj(&m);
+            }
+            shapes.push(tri_mesh(m, bsdf, Some(radiance), "<random light>"));
+        }
+    }
+
+    /// Now and then a point light.
+    fn point_lights(&mut self, f: &mut Features) -> Vec<PointLightDesc> {
+        let mut point_lights = Vec::new();
+        if self.chance(0.12) {
+            f.point_lights += 1;
+            point_lights.push(PointLightDesc {
+                position: Vec3::new(self.f(-2.0, 2.0), self.f(-2.0, 2.0), self.f(1.0, 3.0)),
+                intensity: self.rgb(1.0, 10.0),
+                origin: "<random point light>".into(),
+            });
+        }
+        point_lights
+    }
+
+    /// A camera looking at the scene from above, with any fov axis and film size and filter.
+    fn camera_and_film(&mut self) -> (CameraDesc, FilmDesc) {
+        let dir = Vec3::new(self.f(-1.0, 1.0), self.f(-1.0, 1.0), self.f(0.3, 1.2)).normalize();
+        let eye = dir * self.f(4.0, 7.0);
+        let target = Vec3::new(self.f(-0.5, 0.5), self.f(-0.5, 0.5), self.f(0.0, 0.5));
+        let up = if dir.cross(Vec3::Z).length() > 0.05 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        };
+        let fov_axis = [
+            FovAxis::X,
+            FovAxis::Y,
+            FovAxis::Diagonal,
+            FovAxis::Smaller,
+            FovAxis::Larger,
+        ][self.below(5) as usize];
+        let filter = match self.below(3) {
+            0 => FilterDesc::Box,
+            1 => FilterDesc::Tent {
+                radius: self.f(0.5, 2.0),
+            },
+            _ => {
+                let stddev = self.f(0.3, 1.0);
+                FilterDesc::Gaussian {
+                    stddev,
+                    radius: 2.0 * stddev,
+                }
+            }
+        };
+        let camera = CameraDesc {
+            to_world: look_at(eye, target, up),
+            fov_degrees: self.f(25.0, 60.0),
+            fov_axis,
+            near_clip: 1e-3,
+            far_clip: 1e4,
+        };
+        let film = FilmDesc {
+            width: 5 + self.below(10),
+            height: 5 + self.below(10),
+            filter,
+        };
+        (camera, film)
+    }
+}
+
 pub fn random_scene(seed: u64, dir: &Path) -> RandomScene {
     let dir = dir.join(format!("scene{seed}"));
     std::fs::create_dir_all(&dir).unwrap();
@@ -288,152 +447,14 @@ pub fn random_scene(seed: u64, dir: &Path) -> RandomScene {
     };
     let mut f = Features::default();
     let mut shapes = Vec::new();
-
-    // A floor under everything, so most pixels see a receiver.
-    let (bsdf, name) = g.material();
-    f.materials.push(name);
-    let floor = match g.chance(0.5) {
-        true => {
-            f.smooth_receivers += 1;
-            g.bumpy_floor(3.0)
-        }
-        false => {
-            let mut m = super::mesh::rectangle();
-            m.transform(&Mat4::from_scale(Vec3::splat(3.0)));
-            m
-        }
-    };
-    shapes.push(tri_mesh(floor, bsdf, None, "<random floor>"));
-
-    for _ in 0..1 + g.below(4) {
-        let (bsdf, name) = g.material();
-        f.materials.push(name);
-        let c = Vec3::new(g.f(-1.5, 1.5), g.f(-1.5, 1.5), g.f(0.3, 1.2));
-        let r = g.f(0.15, 0.6);
-        shapes.push(match g.below(4) {
-            0 => {
-                f.smooth_receivers += 1;
-                let m = g.uv_sphere(c, r);
-                tri_mesh(m, bsdf, None, "<random smooth sphere>")
-            }
-            1 => sphere(c, r, bsdf, None),
-            2 => {
-                let mut m = cube();
-                m.transform(&(Mat4::from_translation(c) * Mat4::from_scale(Vec3::splat(r))));
-                tri_mesh(m, bsdf, None, "<random cube>")
-            }
-            _ => {
-                let v = [g.unit(), g.unit(), g.unit()].map(|d| c + 2.0 * r * d);
-                tri_mesh(
-                    TriMesh {
-                        positions: v.to_vec(),
-                        normals: None,
-                        indices: vec![[0, 1, 2]],
-                    },
-                    bsdf,
-                    None,
-                    "<random triangle>",
-                )
-            }
-        });
-    }
-
-    // One to ten lights: the lanes' small tables hold up to eight emitters and up to eight
-    // triangles per mesh, so both sides of each limit come up.
-    let lights = match g.chance(0.75) {
-        true => 1 + g.below(4),
-        false => 5 + g.below(6),
-    };
-    for _ in 0..lights {
-        let c = Vec3::new(g.f(-2.5, 2.5), g.f(-2.5, 2.5), g.f(1.5, 3.5));
-        let radiance = g.rgb(0.5, 8.0);
-        // Emitters reflect as well, now and then.
-        let bsdf = match g.chance(0.3) {
-            true => g.material().0,
-            false => diffuse(0.0),
-        };
-        if g.chance(0.3) {
-            f.lights.push("sphere");
-            shapes.push(sphere(c, g.f(0.05, 0.4), bsdf, Some(radiance)));
-            continue;
-        }
-        // Mostly facing down towards the scene, sometimes away (one-sided: dark from below).
-        let towards = (Vec3::new(g.f(-1.0, 1.0), g.f(-1.0, 1.0), 0.0) - c).normalize();
-        let normal = match g.chance(0.85) {
-            true => (towards + 0.4 * g.unit()).normalize(),
-            false => g.unit(),
-        };
-        let n = match g.chance(0.6) {
-            true => 1 + g.below(8),
-            false => 9 + g.below(12),
-        };
-        let r = g.f(0.1, 0.6);
-        let mut m = g.fan(c, normal, r, n);
-        f.lights.push(if n > 8 { "mesh-big" } else { "mesh" });
-        if g.chance(0.3) {
-            f.lights.push("mesh-smooth");
-            m.normals = Some(
-                m.positions
-                    .iter()
-                    .map(|&p| (normal + 0.5 * (p - c)).normalize())
-                    .collect(),
-            );
-            m = g.through_obj(&m);
-        }
-        shapes.push(tri_mesh(m, bsdf, Some(radiance), "<random light>"));
-    }
-    let mut point_lights = Vec::new();
-    if g.chance(0.12) {
-        f.point_lights += 1;
-        point_lights.push(PointLightDesc {
-            position: Vec3::new(g.f(-2.0, 2.0), g.f(-2.0, 2.0), g.f(1.0, 3.0)),
-            intensity: g.rgb(1.0, 10.0),
-            origin: "<random point light>".into(),
-        });
-    }
-
-    let dir = Vec3::new(g.f(-1.0, 1.0), g.f(-1.0, 1.0), g.f(0.3, 1.2)).normalize();
-    let eye = dir * g.f(4.0, 7.0);
-    let target = Vec3::new(g.f(-0.5, 0.5), g.f(-0.5, 0.5), g.f(0.0, 0.5));
-    let up = if dir.cross(Vec3::Z).length() > 0.05 {
-        Vec3::Z
-    } else {
-        Vec3::Y
-    };
-    let fov_axis = [
-        FovAxis::X,
-        FovAxis::Y,
-        FovAxis::Diagonal,
-        FovAxis::Smaller,
-        FovAxis::Larger,
-    ][g.below(5) as usize];
-    let filter = match g.below(3) {
-        0 => FilterDesc::Box,
-        1 => FilterDesc::Tent {
-            radius: g.f(0.5, 2.0),
-        },
-        _ => {
-            let stddev = g.f(0.3, 1.0);
-            FilterDesc::Gaussian {
-                stddev,
-                radius: 2.0 * stddev,
-            }
-        }
-    };
+    g.receivers(&mut f, &mut shapes);
+    g.lights(&mut f, &mut shapes);
+    let point_lights = g.point_lights(&mut f);
+    let (camera, film) = g.camera_and_film();
     let desc = SceneDesc {
         source: PathBuf::from(format!("<random scene {seed}>")),
-        camera: CameraDesc {
-            to_world: look_at(eye, target, up),
-            fov_degrees: g.f(25.0, 60.0),
-            fov_axis,
-            near_clip: 1e-3,
-            far_clip: 1e4,
-        },
-        film: FilmDesc {
-            width: 5 + g.below(10),
-            height: 5 + g.below(10),
-            filter,
-        },
+        camera,
+        film,
         sampler: SamplerDesc {
             sample_count: 8,
             seed,
