@@ -8,7 +8,7 @@ use super::plan::{
     has_image, image_path, plan_sweep, rate, same_run, time_tag, variance_path, Job, Sweep,
 };
 use super::results::{Results, Row, EQUAL_TIME};
-use super::schema::Resolved;
+use super::schema::{EqualTimeSpec, Resolved};
 use crate::film;
 use crate::integrator::Strategy;
 use crate::render::{render, RenderSettings};
@@ -137,24 +137,82 @@ fn rendered_reference(
     Ok((key, reference))
 }
 
-pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, String> {
-    let start = Instant::now();
-    let dir = opts.out.join(&exp.name);
-    let scene = crate::scene::open(exp.scene(), exp.defines())?;
-    let base = Strategy::from_desc(&scene.desc.integrator);
+/// Strategies with their legend names.
+type Named = Vec<(String, Strategy)>;
+
+/// The experiment's strategies on the scene's settings `base`, without those that are the
+/// same estimator on this scene or cannot see its light (each said on stderr).
+fn strategies(
+    exp: &Resolved,
+    base: Strategy,
+    scene: &Scene,
+) -> Result<(Named, Vec<Omission>), String> {
     let listed: Vec<(String, Strategy)> = exp
         .exp
         .strategies
         .iter()
         .map(|s| Ok((s.name.clone(), s.on(base)?)))
         .collect::<Result<_, String>>()?;
-    let (kept, omitted) = leave_out(&listed, &SceneTraits::of(&scene));
+    let (kept, omitted) = leave_out(&listed, &SceneTraits::of(scene));
     for o in &omitted {
         eprintln!(
             "{}: leaving out '{}' ({}): {}",
             exp.name, o.name, o.label, o.reason
         );
     }
+    Ok((kept, omitted))
+}
+
+/// The equal-time runs still to do: each budget, seed and strategy without its row and
+/// image, at the spp the sweep's measured rate gives the budget.
+fn equal_time_jobs(
+    et: &EqualTimeSpec,
+    kept: &[(String, Strategy)],
+    results: &Results,
+    dir: &Path,
+    pixels: u64,
+) -> Result<Vec<Job>, String> {
+    let mut timed = Vec::new();
+    for &budget in &et.seconds {
+        for seed in 0..et.seeds as u64 {
+            for (name, s) in kept {
+                let label = s.label();
+                let image = Some(image_path(dir, &label, &time_tag(budget), seed));
+                let old = results.find_equal_time(&label, budget, seed);
+                if old.is_some() && has_image(&image) {
+                    continue;
+                }
+                // Re-rendering a row whose image is missing reuses its spp, so the row
+                // and the figure show the same render.
+                let spp = match old {
+                    Some(r) => r.spp,
+                    None => {
+                        let r = rate(&results.rows, &label)
+                            .ok_or_else(|| format!("no sweep rows for {label} to time it from"))?;
+                        ((budget * r / pixels as f64).round() as u32).max(1)
+                    }
+                };
+                timed.push(Job {
+                    name: name.clone(),
+                    strategy: *s,
+                    kind: EQUAL_TIME,
+                    budget,
+                    spp,
+                    seed,
+                    image,
+                });
+            }
+        }
+    }
+    Ok(timed)
+}
+
+pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, String> {
+    let start = Instant::now();
+    let dir = opts.out.join(&exp.name);
+    let scene = crate::scene::open(exp.scene(), exp.defines())?;
+    let base = Strategy::from_desc(&scene.desc.integrator);
+    let (kept, omitted) = strategies(&exp, base, &scene)?;
 
     let x = &exp.exp;
     let eps = x.metrics.relmse_epsilon;
@@ -230,41 +288,10 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
         run(job, &mut results)?;
     }
 
-    let mut timed = Vec::new();
-    if let Some(et) = &x.equal_time {
-        for &budget in &et.seconds {
-            for seed in 0..et.seeds as u64 {
-                for (name, s) in &kept {
-                    let label = s.label();
-                    let image = Some(image_path(&dir, &label, &time_tag(budget), seed));
-                    let old = results.find_equal_time(&label, budget, seed);
-                    if old.is_some() && has_image(&image) {
-                        continue;
-                    }
-                    // Re-rendering a row whose image is missing reuses its spp, so the row
-                    // and the figure show the same render.
-                    let spp = match old {
-                        Some(r) => r.spp,
-                        None => {
-                            let r = rate(&results.rows, &label).ok_or_else(|| {
-                                format!("no sweep rows for {label} to time it from")
-                            })?;
-                            ((budget * r / pixels as f64).round() as u32).max(1)
-                        }
-                    };
-                    timed.push(Job {
-                        name: name.clone(),
-                        strategy: *s,
-                        kind: EQUAL_TIME,
-                        budget,
-                        spp,
-                        seed,
-                        image,
-                    });
-                }
-            }
-        }
-    }
+    let timed = match &x.equal_time {
+        Some(et) => equal_time_jobs(et, &kept, &results, &dir, pixels)?,
+        None => Vec::new(),
+    };
     bar.inc_length(timed.iter().map(|j| j.spp as u64 * pixels).sum());
     for job in &timed {
         run(job, &mut results)?;

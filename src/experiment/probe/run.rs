@@ -9,9 +9,10 @@ use super::rows::{rows, StreamInfo};
 use super::samples::pixel_samples;
 use super::stats::{stream, Stream};
 use crate::experiment::cache::{self, Fnv};
-use crate::experiment::cases::Case;
+use crate::experiment::cases::{Case, ProbeSpec};
 use crate::experiment::leftout::{leave_out, Omission, SceneTraits};
 use crate::experiment::results::{Results, Row};
+use crate::experiment::schema::Experiment;
 use crate::experiment::{Resolved, RunOptions};
 use crate::integrator::{Direct, Strategy};
 use crate::scene::{load_scene, Scene};
@@ -125,16 +126,18 @@ fn context(exp: &Resolved, c: &Case, base: &Strategy) -> Result<String, String> 
     Ok(h.hex())
 }
 
-pub fn run_probe(exp: Resolved, opts: &RunOptions) -> Result<ProbeOutcome, String> {
-    let start = Instant::now();
-    let dir = opts.out.join(&exp.name);
+/// `open_cases`' result: the cases, their scenes, and the checks of their warnings.
+type OpenCases = (Vec<CaseRun>, Vec<Scene>, Vec<Check>);
+
+/// Each case's scene, with the strategies kept on it, and the checks of the warnings its
+/// loading gave; a probe pixel outside a case's film is an error.
+fn open_cases(exp: &Resolved, p: &ProbeSpec) -> Result<OpenCases, String> {
     let x = &exp.exp;
-    let p = x.probe.clone().expect("probe mode");
     let mut cases = Vec::new();
     let mut scenes = Vec::new();
     let mut warned_checks = Vec::new();
     for c in &exp.cases {
-        let (scene, warned, computed) = open_case(&exp, c)?;
+        let (scene, warned, computed) = open_case(exp, c)?;
         let (w, h) = (scene.camera.width, scene.camera.height);
         if p.pixel[0] >= w || p.pixel[1] >= h {
             return Err(format!(
@@ -157,11 +160,66 @@ pub fn run_probe(exp: Resolved, opts: &RunOptions) -> Result<ProbeOutcome, Strin
             closed_form: computed,
             kept,
             omitted,
-            context: context(&exp, c, &base)?,
+            context: context(exp, c, &base)?,
             case: c.clone(),
         });
         scenes.push(scene);
     }
+    Ok((cases, scenes, warned_checks))
+}
+
+/// The (case, strategy, seed) streams still to draw, and how many streams there are: a
+/// stream is done when every sweep spp has its row.
+fn pending_streams(
+    cases: &[CaseRun],
+    results: &Results,
+    x: &Experiment,
+) -> (Vec<(usize, usize, u64)>, usize) {
+    let mut jobs = Vec::new();
+    let mut streams = 0;
+    for (ci, c) in cases.iter().enumerate() {
+        for (si, (_, s)) in c.kept.iter().enumerate() {
+            for seed in 0..x.seeds as u64 {
+                streams += 1;
+                let label = s.label();
+                let have = results
+                    .rows
+                    .iter()
+                    .filter(|r| r.case == c.case.name && r.strategy == label && r.seed == seed)
+                    .count();
+                if have < x.spp.len() {
+                    jobs.push((ci, si, seed));
+                }
+            }
+        }
+    }
+    (jobs, streams)
+}
+
+/// The `[[invalid]]` entries: each scene must fail, or warn, with the given text.
+fn invalid_checks(exp: &Resolved) -> Vec<Check> {
+    let x = &exp.exp;
+    let mut checks = Vec::new();
+    for v in &x.invalid {
+        let scene = exp.path(&v.scene);
+        let defines = crate::experiment::cases::merge_defines(&[&v.defines]);
+        let (expect, text) = match (&v.error, &v.warning) {
+            (Some(e), _) => ("error", e),
+            (None, Some(w)) => ("warning", w),
+            (None, None) => unreachable!("validated: one of error and warning"),
+        };
+        let shown = v.scene.display().to_string();
+        checks.push(check(shown, expect, text, try_scene(&scene, &defines)));
+    }
+    checks
+}
+
+pub fn run_probe(exp: Resolved, opts: &RunOptions) -> Result<ProbeOutcome, String> {
+    let start = Instant::now();
+    let dir = opts.out.join(&exp.name);
+    let x = &exp.exp;
+    let p = x.probe.clone().expect("probe mode");
+    let (cases, scenes, warned_checks) = open_cases(&exp, &p)?;
 
     let csv = dir.join("results.csv");
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -181,25 +239,7 @@ pub fn run_probe(exp: Resolved, opts: &RunOptions) -> Result<ProbeOutcome, Strin
         );
     }
 
-    // A stream is done when every sweep spp has its row.
-    let mut jobs = Vec::new();
-    let mut streams = 0;
-    for (ci, c) in cases.iter().enumerate() {
-        for (si, (_, s)) in c.kept.iter().enumerate() {
-            for seed in 0..x.seeds as u64 {
-                streams += 1;
-                let label = s.label();
-                let have = results
-                    .rows
-                    .iter()
-                    .filter(|r| r.case == c.case.name && r.strategy == label && r.seed == seed)
-                    .count();
-                if have < x.spp.len() {
-                    jobs.push((ci, si, seed));
-                }
-            }
-        }
-    }
+    let (jobs, streams) = pending_streams(&cases, &results, x);
     let order: BTreeMap<(String, String), (usize, usize)> = cases
         .iter()
         .enumerate()
@@ -286,18 +326,7 @@ pub fn run_probe(exp: Resolved, opts: &RunOptions) -> Result<ProbeOutcome, Strin
     let results = shared.into_inner().expect("no panics while held");
 
     let accumulation = run_accumulation(&exp, &cases, &dir, opts)?;
-    let mut checks = Vec::new();
-    for v in &x.invalid {
-        let scene = exp.path(&v.scene);
-        let defines = crate::experiment::cases::merge_defines(&[&v.defines]);
-        let (expect, text) = match (&v.error, &v.warning) {
-            (Some(e), _) => ("error", e),
-            (None, Some(w)) => ("warning", w),
-            (None, None) => unreachable!("validated: one of error and warning"),
-        };
-        let shown = v.scene.display().to_string();
-        checks.push(check(shown, expect, text, try_scene(&scene, &defines)));
-    }
+    let mut checks = invalid_checks(&exp);
     checks.extend(warned_checks);
     Ok(ProbeOutcome {
         exp: exp.clone(),
