@@ -1,7 +1,7 @@
 //! From a `SceneDesc` to the renderer's runtime scene: materials, emitters, sampling tables
 //! and the BVH. Checks what only makes sense once geometry is known (degenerate emitters).
 
-use super::desc::{SceneDesc, ShapeGeometry};
+use super::desc::{AreaEmitterDesc, SceneDesc, ShapeGeometry};
 use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::emitter::{AreaLight, Emitter, LightSample, PointLight};
@@ -76,6 +76,106 @@ fn check_rgb(origin: &str, what: &str, c: Rgb) -> Result<(), BuildError> {
     Ok(())
 }
 
+/// The runtime shape of a shape description, with its input checked.
+fn shape_kind(o: &str, geometry: &ShapeGeometry) -> Result<ShapeKind, BuildError> {
+    Ok(match geometry {
+        ShapeGeometry::Mesh {
+            positions,
+            normals,
+            indices,
+        } => {
+            if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+                return Err(err(o, format!("mesh has a non-finite vertex {p}")));
+            }
+            if let Some(t) = indices
+                .iter()
+                .find(|t| t.iter().any(|&i| i as usize >= positions.len()))
+            {
+                return Err(err(
+                    o,
+                    format!(
+                        "triangle {t:?} indexes past the {} vertices",
+                        positions.len()
+                    ),
+                ));
+            }
+            ShapeKind::Mesh(Mesh::new(
+                positions.clone(),
+                normals.clone(),
+                indices.clone(),
+            ))
+        }
+        ShapeGeometry::Sphere {
+            center,
+            radius,
+            flip_normals,
+        } => {
+            if !center.is_finite() || !radius.is_finite() || *radius <= 0.0 {
+                return Err(err(o, format!("sphere needs a finite centre and positive radius, found {center} / {radius}")));
+            }
+            ShapeKind::Sphere(Sphere {
+                center: *center,
+                radius: *radius,
+                flip_normals: *flip_normals,
+            })
+        }
+    })
+}
+
+/// The area light of shape `shape` (its area, and the triangle table of a mesh), with its
+/// input checked; degenerate triangles and zero radiance are warnings.
+fn area_light(
+    o: &str,
+    shape: u32,
+    kind: &ShapeKind,
+    e: &AreaEmitterDesc,
+    warnings: &mut Vec<String>,
+) -> Result<Emitter, BuildError> {
+    check_rgb(o, "emitter radiance", e.radiance)?;
+    let (area, triangles) = match kind {
+        ShapeKind::Mesh(m) => {
+            let areas: Vec<f64> = (0..m.indices.len())
+                .map(|t| m.triangle_area(t) as f64)
+                .collect();
+            if let Some(t) = areas.iter().position(|a| !a.is_finite()) {
+                return Err(err(o, format!(
+                    "emitter triangle {t}'s area overflows single precision (more than {:e}): the scene is too large for f32; scale it down",
+                    f32::MAX
+                )));
+            }
+            let degenerate = areas.iter().filter(|a| **a == 0.0).count();
+            let table = AliasTable::new(&areas).ok_or_else(|| {
+                err(
+                    o,
+                    "emitter mesh has zero total area (every triangle is degenerate)",
+                )
+            })?;
+            if degenerate > 0 {
+                warnings.push(format!(
+                    "{o}: {degenerate} zero-area triangle(s) in an emitter mesh are never sampled (they emit nothing)"
+                ));
+            }
+            (table.total() as f32, Some(table))
+        }
+        ShapeKind::Sphere(s) => (s.area(), None),
+    };
+    if !area.is_finite() {
+        return Err(err(o, format!(
+            "the emitter's total area overflows single precision (more than {:e}): the scene is too large for f32; scale it down",
+            f32::MAX
+        )));
+    }
+    if e.radiance == Rgb::ZERO {
+        warnings.push(format!("{o}: emitter has zero radiance"));
+    }
+    Ok(Emitter::Area(AreaLight {
+        shape,
+        radiance: e.radiance,
+        area,
+        triangles,
+    }))
+}
+
 /// Where a shadow ray from an origin to a target (at t = 1) stops: just short of the target.
 const SHADOW_TMAX: f32 = 1.0 - 1e-4;
 
@@ -90,95 +190,14 @@ impl Scene {
             let o = sd.origin.as_str();
             let shape_index = shapes.len() as u32;
             materials.push(sd.bsdf.clone());
-            let kind = match &sd.geometry {
-                ShapeGeometry::Mesh {
-                    positions,
-                    normals,
-                    indices,
-                } => {
-                    if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
-                        return Err(err(o, format!("mesh has a non-finite vertex {p}")));
-                    }
-                    if let Some(t) = indices
-                        .iter()
-                        .find(|t| t.iter().any(|&i| i as usize >= positions.len()))
-                    {
-                        return Err(err(
-                            o,
-                            format!(
-                                "triangle {t:?} indexes past the {} vertices",
-                                positions.len()
-                            ),
-                        ));
-                    }
-                    ShapeKind::Mesh(Mesh::new(
-                        positions.clone(),
-                        normals.clone(),
-                        indices.clone(),
-                    ))
+            let kind = shape_kind(o, &sd.geometry)?;
+            let emitter = match &sd.emitter {
+                Some(e) => {
+                    emitters.push(area_light(o, shape_index, &kind, e, &mut warnings)?);
+                    Some(emitters.len() as u32 - 1)
                 }
-                ShapeGeometry::Sphere {
-                    center,
-                    radius,
-                    flip_normals,
-                } => {
-                    if !center.is_finite() || !radius.is_finite() || *radius <= 0.0 {
-                        return Err(err(o, format!("sphere needs a finite centre and positive radius, found {center} / {radius}")));
-                    }
-                    ShapeKind::Sphere(Sphere {
-                        center: *center,
-                        radius: *radius,
-                        flip_normals: *flip_normals,
-                    })
-                }
+                None => None,
             };
-            let mut emitter = None;
-            if let Some(e) = &sd.emitter {
-                check_rgb(o, "emitter radiance", e.radiance)?;
-                let (area, triangles) = match &kind {
-                    ShapeKind::Mesh(m) => {
-                        let areas: Vec<f64> = (0..m.indices.len())
-                            .map(|t| m.triangle_area(t) as f64)
-                            .collect();
-                        if let Some(t) = areas.iter().position(|a| !a.is_finite()) {
-                            return Err(err(o, format!(
-                                "emitter triangle {t}'s area overflows single precision (more than {:e}): the scene is too large for f32; scale it down",
-                                f32::MAX
-                            )));
-                        }
-                        let degenerate = areas.iter().filter(|a| **a == 0.0).count();
-                        let table = AliasTable::new(&areas).ok_or_else(|| {
-                            err(
-                                o,
-                                "emitter mesh has zero total area (every triangle is degenerate)",
-                            )
-                        })?;
-                        if degenerate > 0 {
-                            warnings.push(format!(
-                                "{o}: {degenerate} zero-area triangle(s) in an emitter mesh are never sampled (they emit nothing)"
-                            ));
-                        }
-                        (table.total() as f32, Some(table))
-                    }
-                    ShapeKind::Sphere(s) => (s.area(), None),
-                };
-                if !area.is_finite() {
-                    return Err(err(o, format!(
-                        "the emitter's total area overflows single precision (more than {:e}): the scene is too large for f32; scale it down",
-                        f32::MAX
-                    )));
-                }
-                if e.radiance == Rgb::ZERO {
-                    warnings.push(format!("{o}: emitter has zero radiance"));
-                }
-                emitter = Some(emitters.len() as u32);
-                emitters.push(Emitter::Area(AreaLight {
-                    shape: shape_index,
-                    radiance: e.radiance,
-                    area,
-                    triangles,
-                }));
-            }
             shapes.push(Shape {
                 kind,
                 material: shape_index,
