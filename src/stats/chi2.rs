@@ -264,6 +264,48 @@ pub fn chi2_sf(statistic: f64, dof: usize) -> f64 {
         .sf(statistic)
 }
 
+/// The test's categories (observed, expected): every cell with expected samples, plus
+/// "lost" when the sampler failed at all. An error where the sampler put samples (or
+/// failures) where the pdf leaves no probability.
+fn categories(result: &Chi2Result, cfg: &Chi2Config) -> Result<Vec<(f64, f64)>, String> {
+    let (cols, rows) = (result.observed.cols, result.observed.rows);
+    let (n, lost, pdf_integral) = (result.samples, result.lost, result.pdf_integral);
+    let nf = n as f64;
+    let zero = 1e-12 * nf;
+    let tolerated = cfg.zero_tolerance * nf;
+    let mut cells: Vec<(f64, f64)> = Vec::with_capacity(cols * rows + 1);
+    for (i, (&obs, &exp)) in result
+        .observed
+        .data
+        .iter()
+        .zip(&result.expected.data)
+        .enumerate()
+    {
+        if exp > zero {
+            cells.push((obs, exp));
+        } else if obs > tolerated {
+            let (c, r) = (i % cols, i / cols);
+            return Err(format!(
+                    "{obs} samples in cell (col {c}, row {r}) where the pdf integrates to 0 \
+                     (tolerance {tolerated:.1}): the sampler produces points its pdf says are impossible"
+            ));
+        }
+    }
+    if lost > 0 {
+        let exp_lost = (nf * (1.0 - pdf_integral)).max(0.0);
+        if exp_lost <= zero && lost as f64 > tolerated {
+            return Err(format!(
+                "sampler failed (returned None) {lost} times of {n}, but the pdf integrates \
+                     to {pdf_integral:.6}, leaving no probability for failure"
+            ));
+        }
+        if exp_lost > zero {
+            cells.push((lost as f64, exp_lost));
+        }
+    }
+    Ok(cells)
+}
+
 /// Runs the sampler `cfg.samples` times and tests its histogram against `pdf`.
 pub fn chi2_test<D: Domain>(
     domain: &D,
@@ -332,45 +374,10 @@ pub fn chi2_test<D: Domain>(
         );
     }
 
-    // Categories: every cell, plus "lost" when the sampler failed at all.
-    let zero = 1e-12 * nf;
-    let tolerated = cfg.zero_tolerance * nf;
-    let mut cells: Vec<(f64, f64)> = Vec::with_capacity(cols * rows + 1);
-    for (i, (&obs, &exp)) in result
-        .observed
-        .data
-        .iter()
-        .zip(&result.expected.data)
-        .enumerate()
-    {
-        if exp > zero {
-            cells.push((obs, exp));
-        } else if obs > tolerated {
-            let (c, r) = (i % cols, i / cols);
-            return fail(
-                result,
-                format!(
-                    "{obs} samples in cell (col {c}, row {r}) where the pdf integrates to 0 \
-                     (tolerance {tolerated:.1}): the sampler produces points its pdf says are impossible"
-                ),
-            );
-        }
-    }
-    if lost > 0 {
-        let exp_lost = (nf * (1.0 - pdf_integral)).max(0.0);
-        if exp_lost <= zero && lost as f64 > tolerated {
-            return fail(
-                result,
-                format!(
-                    "sampler failed (returned None) {lost} times of {n}, but the pdf integrates \
-                     to {pdf_integral:.6}, leaving no probability for failure"
-                ),
-            );
-        }
-        if exp_lost > zero {
-            cells.push((lost as f64, exp_lost));
-        }
-    }
+    let mut cells = match categories(&result, cfg) {
+        Ok(cells) => cells,
+        Err(reason) => return fail(result, reason),
+    };
 
     let Some(p) = pearson(&mut cells, cfg.min_expected) else {
         return fail(
