@@ -258,7 +258,45 @@ fn ray_limit_section(
         raw.closest_per_s / 1e6,
         raw.occlusion_per_s / 1e6,
     );
-    let one_thread = [
+    let one_thread =
+        one_thread_rows(&limit, (share_banded, outside_banded), &raw).map(|row| (1, row));
+    let most_threads = parallel.into_iter().flat_map(|(share, outside, banded)| {
+        [
+            ("share_outside_traversal", share, "fraction"),
+            (
+                "outside_traversal_per_sample",
+                outside * 1e9,
+                "ns thread time",
+            ),
+            ("share_outside_traversal_banded", banded.0, "fraction"),
+            (
+                "outside_traversal_per_sample_banded",
+                banded.1 * 1e9,
+                "ns thread time",
+            ),
+        ]
+        .map(|row| (max_threads, row))
+    });
+    for (threads, (what, v, unit)) in one_thread.into_iter().chain(most_threads) {
+        rows.push(Row {
+            section: "ray_limit",
+            scene: name.to_string(),
+            strategy: format!("{}:{what}", mis.label()),
+            threads,
+            n: 0,
+            value: v,
+            unit,
+        });
+    }
+}
+
+/// The ray-tracing limit's rows on one thread: (name, value, unit).
+fn one_thread_rows(
+    limit: &raylimit::Limit,
+    (share_banded, outside_banded): (f64, f64),
+    raw: &raylimit::RayLimit,
+) -> [(&'static str, f64, &'static str); 13] {
+    [
         ("closest_hit_rays", limit.by_type.closest_per_s, "rays/s"),
         ("occlusion_rays", limit.by_type.occlusion_per_s, "rays/s"),
         ("bsdf_emitter_query_rays", limit.bsdf_query_per_s, "rays/s"),
@@ -293,35 +331,6 @@ fn ray_limit_section(
         ("obvhs_closest_hit_rays", raw.closest_per_s, "rays/s"),
         ("obvhs_occlusion_rays", raw.occlusion_per_s, "rays/s"),
     ]
-    .map(|row| (1, row));
-    let most_threads = parallel.into_iter().flat_map(|(share, outside, banded)| {
-        [
-            ("share_outside_traversal", share, "fraction"),
-            (
-                "outside_traversal_per_sample",
-                outside * 1e9,
-                "ns thread time",
-            ),
-            ("share_outside_traversal_banded", banded.0, "fraction"),
-            (
-                "outside_traversal_per_sample_banded",
-                banded.1 * 1e9,
-                "ns thread time",
-            ),
-        ]
-        .map(|row| (max_threads, row))
-    });
-    for (threads, (what, v, unit)) in one_thread.into_iter().chain(most_threads) {
-        rows.push(Row {
-            section: "ray_limit",
-            scene: name.to_string(),
-            strategy: format!("{}:{what}", mis.label()),
-            threads,
-            n: 0,
-            value: v,
-            unit,
-        });
-    }
 }
 
 fn least(x: &[f64]) -> f64 {
