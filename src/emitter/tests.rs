@@ -148,24 +148,6 @@ fn grazing_light_points_emit_nothing_and_have_no_density() {
 /// 1e-5 margin of its surface, or when its normals point inwards, by area.
 #[test]
 fn sphere_light_uses_its_cone_exactly_when_seen_from_outside() {
-    use crate::sampling::warps::square_to_uniform_sphere;
-    let ball = |flip: bool| {
-        let mut d = shapes_only(vec![sphere(C, 1.0, diffuse(0.0), Some(Rgb::ONE))]);
-        if let crate::scene::desc::ShapeGeometry::Sphere { flip_normals, .. } =
-            &mut d.shapes[0].geometry
-        {
-            *flip_normals = flip;
-        }
-        Scene::build(d).unwrap()
-    };
-    let by_area = |s: &Scene, ref_p: Vec3, ls: &LightSample| {
-        let cos_l = ls.ng.dot(ls.wi).abs();
-        let want = ls.dist * ls.dist / (4.0 * PI * cos_l);
-        let got = s.emitters[0].pdf(&s.shapes, ref_p, &point_of(ls), LightSampling::SolidAngle);
-        (ls.pdf, got, want)
-    };
-    // Off the origin, so that centre - p and p - centre differ.
-    const C: Vec3 = Vec3::new(0.5, -1.0, 2.0);
     let mut rng = crate::rng::Rng::new(3, 0);
     let outside = ball(false);
     // At 1.2 radii the point is outside by far more than the margin of 1e-5 in dc^2 / r^2.
@@ -222,6 +204,16 @@ fn sphere_light_uses_its_cone_exactly_when_seen_from_outside() {
             "{ref_p}: mean cos {mean} against {want}"
         );
     }
+}
+
+/// Seen from inside, or with its normals inwards, or within the margin of its surface, a
+/// sphere light is sampled by area, as `sphere_light_uses_its_cone_exactly_when_seen_from_outside`'s
+/// other side.
+#[test]
+fn sphere_light_is_sampled_by_area_where_its_cone_does_not_apply() {
+    use crate::sampling::warps::square_to_uniform_sphere;
+    let mut rng = crate::rng::Rng::new(3, 1);
+    let outside = ball(false);
     // Inside (lit where the normals point inwards), just outside the surface (within the
     // margin), and inward normals from outside: uniform points on the sphere, by area.
     let cases = [
@@ -270,6 +262,28 @@ fn sphere_light_uses_its_cone_exactly_when_seen_from_outside() {
     };
     let (_, eval, want) = by_area(&outside, ref_p, &near);
     assert!((eval / want - 1.0).abs() < 1e-3, "{eval} against {want}");
+}
+
+/// Centre of the test sphere: off the origin, so that centre - p and p - centre differ.
+const C: Vec3 = Vec3::new(0.5, -1.0, 2.0);
+
+/// A unit sphere light at `C`, its normals inwards with `flip`.
+fn ball(flip: bool) -> Scene {
+    let mut d = shapes_only(vec![sphere(C, 1.0, diffuse(0.0), Some(Rgb::ONE))]);
+    if let crate::scene::desc::ShapeGeometry::Sphere { flip_normals, .. } =
+        &mut d.shapes[0].geometry
+    {
+        *flip_normals = flip;
+    }
+    Scene::build(d).unwrap()
+}
+
+/// A sphere sample's reported density, `pdf()`'s, and the area density in solid angle.
+fn by_area(s: &Scene, ref_p: Vec3, ls: &LightSample) -> (f32, f32, f32) {
+    let cos_l = ls.ng.dot(ls.wi).abs();
+    let want = ls.dist * ls.dist / (4.0 * PI * cos_l);
+    let got = s.emitters[0].pdf(&s.shapes, ref_p, &point_of(ls), LightSampling::SolidAngle);
+    (ls.pdf, got, want)
 }
 
 /// The surface point a light sample names, as a BSDF ray would find it.
