@@ -214,6 +214,30 @@ fn invalid_checks(exp: &Resolved) -> Vec<Check> {
     checks
 }
 
+/// The rows of `csv` still valid for these cases: rows of other cases, scenes, references,
+/// settings or batch sizes no longer swept are dropped (and counted), since the sweep is
+/// exactly `spp`.
+fn load_results(
+    exp: &Resolved,
+    cases: &[CaseRun],
+    csv: &std::path::Path,
+) -> Result<Results, String> {
+    let contexts: BTreeMap<&str, &str> = cases
+        .iter()
+        .map(|c| (c.case.name.as_str(), c.context.as_str()))
+        .collect();
+    let results = Results::load_where(csv, |r| {
+        contexts.get(r.case.as_str()) == Some(&r.context.as_str()) && exp.exp.spp.contains(&r.spp)
+    })?;
+    if results.dropped > 0 {
+        eprintln!(
+            "{}: {} rows of results.csv belong to other cases, scenes, references or settings and are dropped",
+            exp.name, results.dropped
+        );
+    }
+    Ok(results)
+}
+
 pub fn run_probe(exp: Resolved, opts: &RunOptions) -> Result<ProbeOutcome, String> {
     let start = Instant::now();
     let dir = opts.out.join(&exp.name);
@@ -223,21 +247,8 @@ pub fn run_probe(exp: Resolved, opts: &RunOptions) -> Result<ProbeOutcome, Strin
 
     let csv = dir.join("results.csv");
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let contexts: BTreeMap<&str, &str> = cases
-        .iter()
-        .map(|c| (c.case.name.as_str(), c.context.as_str()))
-        .collect();
-    // Rows of batch sizes no longer swept are dropped too: the sweep is exactly `spp`.
-    let results = Results::load_where(&csv, |r| {
-        contexts.get(r.case.as_str()) == Some(&r.context.as_str()) && x.spp.contains(&r.spp)
-    })?;
+    let results = load_results(&exp, &cases, &csv)?;
     let dropped = results.dropped;
-    if dropped > 0 {
-        eprintln!(
-            "{}: {dropped} rows of results.csv belong to other cases, scenes, references or settings and are dropped",
-            exp.name
-        );
-    }
 
     let (jobs, streams) = pending_streams(&cases, &results, x);
     let order: BTreeMap<(String, String), (usize, usize)> = cases
