@@ -417,3 +417,7 @@ mod tests {
 #[cfg(test)]
 #[path = "render_lanes_tests.rs"]
 mod lanes_tests;
+
+#[cfg(test)]
+#[path = "render_checksums_tests.rs"]
+mod checksums_tests;
