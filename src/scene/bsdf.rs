@@ -172,13 +172,13 @@ impl<'a> Loader<'a> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use crate::bsdf::{Material, REGISTERED};
     use crate::scene::load_scene_str;
     use std::path::Path;
 
     /// The shape's material of a Mitsuba 3 scene around `bsdf`, or the loader's message.
-    fn read(bsdf: &str) -> Result<Material, String> {
+    pub(crate) fn read(bsdf: &str) -> Result<Material, String> {
         let xml = format!(
             r#"<scene version="3.0.0">
                  <sensor type="perspective"><float name="fov" value="45"/></sensor>

@@ -12,14 +12,12 @@
 //!   shares no code with the sampler) is at most 1 + 2e-3, and agrees with the sampled one.
 
 use super::bsdf::supported_bsdfs;
-use super::{load_scene_str, Scene};
 use crate::bsdf::fresnel::fresnel_dielectric;
 use crate::bsdf::{BsdfKind, Material};
 use crate::math::Rgb;
 use crate::rng::Rng;
 use crate::sampling::quadrature::LobeGrid;
 use glam::Vec3;
-use std::path::Path;
 
 /// One furnace case: the `<bsdf>` element, whether its albedo is exactly 1 at every
 /// incidence it is lit from, and the roughness of its narrowest lobe (for the quadrature
@@ -131,19 +129,9 @@ fn cases(ty: &str) -> Vec<Case> {
     }
 }
 
-/// The material the renderer builds from `bsdf`, read as part of a Mitsuba 3 scene.
+/// The material the scene reader makes of `bsdf`, read as part of a Mitsuba 3 scene.
 fn material(bsdf: &str) -> Material {
-    let xml = format!(
-        r#"<scene version="3.0.0">
-             <sensor type="perspective"><float name="fov" value="45"/></sensor>
-             <shape type="rectangle">{bsdf}</shape>
-             <emitter type="point"><point name="position" x="0" y="0" z="1"/></emitter>
-           </scene>"#
-    );
-    let desc = load_scene_str(&xml, Path::new("furnace.xml"), &[])
-        .unwrap_or_else(|e| panic!("{bsdf}: {e}"));
-    let scene = Scene::build(desc).unwrap_or_else(|e| panic!("{bsdf}: {e}"));
-    scene.materials[0].clone()
+    super::bsdf::tests::read(bsdf).unwrap_or_else(|e| panic!("{bsdf}: {e}"))
 }
 
 /// Mean energy of a sampled direction from `wi` and its standard error: the weight, with a
