@@ -22,10 +22,14 @@ fn small(cases: usize) -> CaseConfig {
     }
 }
 
-#[test]
-fn every_case_passes_at_reduced_size() {
-    let cases = all_cases();
-    let cfg = small(cases.len());
+/// The cases of one group (`warp/`, `bsdf/`, ...), at the significance of the whole registry
+/// (Sidak over every case), so that the four tests together are the one registry test. One
+/// test per group lets a run that checks one module (mutation testing) take only its group.
+fn group_passes(group: &str) {
+    let all = all_cases();
+    let cfg = small(all.len());
+    let cases: Vec<_> = all.iter().filter(|c| c.name.starts_with(group)).collect();
+    assert!(!cases.is_empty(), "no cases in group {group}");
     let failed: Vec<String> = cases
         .par_iter()
         .map(|c| c.run(&cfg))
@@ -33,6 +37,40 @@ fn every_case_passes_at_reduced_size() {
         .map(|o| format!("{}: {}", o.name, o.summary()))
         .collect();
     assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+#[test]
+fn every_case_passes_at_reduced_size_warp() {
+    group_passes("warp/");
+}
+
+#[test]
+fn every_case_passes_at_reduced_size_discrete() {
+    group_passes("discrete/");
+}
+
+#[test]
+fn every_case_passes_at_reduced_size_bsdf() {
+    group_passes("bsdf/");
+}
+
+#[test]
+fn every_case_passes_at_reduced_size_emitter() {
+    group_passes("emitter/");
+}
+
+/// The four group tests cover every case.
+#[test]
+fn every_case_is_in_a_tested_group() {
+    for c in all_cases() {
+        assert!(
+            ["warp/", "discrete/", "bsdf/", "emitter/"]
+                .iter()
+                .any(|g| c.name.starts_with(g)),
+            "{} is in no tested group",
+            c.name
+        );
+    }
 }
 
 #[test]
