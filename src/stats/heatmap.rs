@@ -163,4 +163,53 @@ mod tests {
         assert_eq!(residual(0.0, 0.0), None);
         assert_eq!(residual(100.0, 4.0), Some(RESIDUAL_CLAMP));
     }
+
+    /// A 3 x 2 grid drawn at 2 pixels a cell, every pixel checked against values worked by
+    /// hand: the panels' places and gaps, rows drawn bottom up, one colour scale for observed
+    /// and expected (peak 8), residuals (obs - exp) / sqrt(exp) on the diverging map, empty
+    /// impossible cells grey, and samples where the pdf is 0 saturated red.
+    #[test]
+    fn panels_cells_and_colours_by_hand() {
+        let grid = |data: [f64; 6]| Grid {
+            cols: 3,
+            rows: 2,
+            data: data.to_vec(),
+        };
+        // Row 0, then row 1.
+        let observed = grid([3.0, 0.0, 8.0, 6.0, 1.0, 0.0]);
+        let expected = grid([3.0, 0.0, 0.0, 4.0, 4.0, 0.0]);
+        let img = render(&observed, &expected, 2);
+        assert_eq!(img.dimensions(), (3 * 6 + 2 * GAP, 4));
+        let rgb = |r, g, b| Rgb([r, g, b]);
+        let (seq_0, seq_1) = (rgb(68, 1, 84), rgb(253, 231, 37));
+        let (seq_375, seq_5) = (rgb(46, 113, 140), rgb(33, 145, 141));
+        // (col, row) -> observed, expected and residual colours.
+        let want = [
+            ((0, 0), [seq_375, seq_375, rgb(255, 255, 255)]),
+            ((1, 0), [seq_0, seq_0, EMPTY]),
+            ((2, 0), [seq_1, seq_0, diverging(1.0)]),
+            // z = (6 - 4) / 2 = 1: 0.2 of the way to red.
+            ((0, 1), [sequential(0.75), seq_5, rgb(247, 209, 209)]),
+            // z = (1 - 4) / 2 = -1.5: 0.3 of the way to blue.
+            ((1, 1), [sequential(0.125), seq_5, rgb(186, 198, 244)]),
+            ((2, 1), [seq_0, seq_0, EMPTY]),
+        ];
+        for ((c, r), colours) in want {
+            for (panel, colour) in colours.into_iter().enumerate() {
+                let x0 = panel as u32 * (6 + GAP) + 2 * c;
+                // Row 1 is drawn above row 0.
+                let y0 = 2 * (1 - r);
+                for (x, y) in [(x0, y0), (x0 + 1, y0 + 1)] {
+                    assert_eq!(
+                        *img.get_pixel(x, y),
+                        colour,
+                        "cell ({c}, {r}) panel {panel}"
+                    );
+                }
+            }
+        }
+        for x in (6..6 + GAP).chain(16..16 + GAP) {
+            assert_eq!(*img.get_pixel(x, 1), BACKGROUND, "gap at x = {x}");
+        }
+    }
 }
