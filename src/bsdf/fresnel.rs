@@ -49,8 +49,7 @@ pub fn is_grey(eta: Rgb, k: Rgb) -> bool {
 /// One channel of `fresnel_conductor`; selects rather than branches, so that it runs in
 /// vector lanes (`integrator::lanes`). In f32, as Mitsuba and pbrt evaluate it: within 1e-6
 /// of the f64 closed form over the loader's range of indices (`conductor_f32_matches_f64`
-/// measures 2e-7). Its f64 square roots and divisions in eight lanes and those of
-/// `RoughConductor::half` together cost the Veach scene 0.8 % of its render time.
+/// measures 2e-7).
 #[inline(always)]
 pub fn fresnel_conductor_channel(cos_i: f32, eta: f32, k: f32) -> f32 {
     let c = cos_i.clamp(0.0, 1.0);

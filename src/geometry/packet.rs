@@ -263,9 +263,8 @@ impl Accel {
     }
 
     /// `intersect` for each ray set in `active`, traced as one packet, into `out` (all of it
-    /// overwritten). Returned by value, the 484-byte hits were copied out by a `memcpy` call
-    /// on every packet (LLVM did not build them in place, even inlined): 0.8-1.1 % of a
-    /// Veach render's time (perf).
+    /// overwritten): returned by value, the 484-byte hits were copied out by a `memcpy` call
+    /// on every packet (LLVM did not build them in place, even inlined).
     pub fn intersect8_into(
         &self,
         rays: &RayPacket,
