@@ -287,3 +287,38 @@ pub(crate) mod testing {
         (mean.as_vec3(), (var / n as f64).as_vec3().map(f32::sqrt))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::params::Defaults;
+    use super::*;
+    use crate::rng::Rng;
+    use crate::sampling::warps::square_to_uniform_sphere;
+
+    /// A delta BSDF has no density: eval and pdf are 0 for every pair of directions, so that
+    /// light samples and MIS weights never see its lobes; its samples say they are delta.
+    #[test]
+    fn delta_bsdfs_have_no_density() {
+        let mut rng = Rng::new(11, 2);
+        for ty in REGISTERED {
+            let kind = BsdfKind::parse(ty, &mut Defaults).unwrap().unwrap();
+            if !kind.is_delta() {
+                continue;
+            }
+            let m = Material {
+                kind,
+                two_sided: false,
+            };
+            for _ in 0..1000 {
+                let wi = square_to_uniform_sphere(rng.next_2d());
+                let wo = square_to_uniform_sphere(rng.next_2d());
+                assert_eq!(m.eval(wi, wo), Rgb::ZERO, "{ty}");
+                assert_eq!(m.pdf(wi, wo), 0.0, "{ty}");
+                assert_eq!(m.eval_pdf(wi, wo), (Rgb::ZERO, 0.0), "{ty}");
+                if let Some(s) = m.sample(wi, rng.next_f32(), rng.next_2d()) {
+                    assert!(s.delta, "{ty}");
+                }
+            }
+        }
+    }
+}
