@@ -44,12 +44,6 @@ impl Bsdf for Conductor {
             specular_reflectance,
         })
     }
-    fn eval(&self, _: Vec3, _: Vec3) -> Rgb {
-        Rgb::ZERO
-    }
-    fn pdf(&self, _: Vec3, _: Vec3) -> f32 {
-        0.0
-    }
     fn sample(&self, wi: Vec3, _: f32, _: Vec2) -> Option<BsdfSample> {
         Conductor::sample(self, wi)
     }

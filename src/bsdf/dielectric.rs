@@ -64,12 +64,6 @@ impl Bsdf for Dielectric {
             eta: int_ior / ext_ior,
         })
     }
-    fn eval(&self, _: Vec3, _: Vec3) -> Rgb {
-        Rgb::ZERO
-    }
-    fn pdf(&self, _: Vec3, _: Vec3) -> f32 {
-        0.0
-    }
     fn sample(&self, wi: Vec3, u1: f32, _: Vec2) -> Option<BsdfSample> {
         Dielectric::sample(self, wi, u1)
     }

@@ -38,12 +38,6 @@ impl Bsdf for Mirror {
     fn from_params<P: Params>(_: &mut P) -> Result<Self, P::Error> {
         Ok(Mirror)
     }
-    fn eval(&self, _: Vec3, _: Vec3) -> Rgb {
-        Rgb::ZERO
-    }
-    fn pdf(&self, _: Vec3, _: Vec3) -> f32 {
-        0.0
-    }
     fn sample(&self, wi: Vec3, _: f32, _: Vec2) -> Option<BsdfSample> {
         Mirror::sample(self, wi)
     }

@@ -43,10 +43,15 @@ pub trait Bsdf: Sized {
     const TWO_SIDED: bool = true;
     /// Reads Mitsuba's (or Nori's) parameters of its `<bsdf>` element.
     fn from_params<P: Params>(p: &mut P) -> Result<Self, P::Error>;
-    /// f(wi, wo) |cos(wo)|.
-    fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb;
-    /// Solid-angle density of `sample`'s directions.
-    fn pdf(&self, wi: Vec3, wo: Vec3) -> f32;
+    /// f(wi, wo) |cos(wo)|. Zero for delta BSDFs, which keep this default; a BSDF with a
+    /// density that kept it would fail its chi-square and weight checks.
+    fn eval(&self, _wi: Vec3, _wo: Vec3) -> Rgb {
+        Rgb::ZERO
+    }
+    /// Solid-angle density of `sample`'s directions; zero for delta BSDFs (the default).
+    fn pdf(&self, _wi: Vec3, _wo: Vec3) -> f32 {
+        0.0
+    }
     /// `(eval, pdf)`, with the work they share done once where a BSDF can.
     fn eval_pdf(&self, wi: Vec3, wo: Vec3) -> (Rgb, f32) {
         (self.eval(wi, wo), self.pdf(wi, wo))

@@ -8,12 +8,7 @@ use crate::bsdf::{
 use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
 use glam::Vec3;
 
-pub(super) fn one(kind: BsdfKind) -> Material {
-    Material {
-        kind,
-        two_sided: false,
-    }
-}
+pub(super) use crate::scene::fixtures::one_sided as one;
 
 pub(super) fn two(m: Material) -> Material {
     Material {
