@@ -6,7 +6,8 @@
 //! per-pixel variance and error are meaningful for the harness.
 
 use crate::geometry::{Ray, RayPacket, NO_SKIP};
-use crate::rng::{Rng, RngLanes, LANES};
+use crate::rng::LANES;
+use crate::sampler::{Sampler, SamplerLanes};
 use crate::scene::desc::{CameraDesc, FilmDesc, FilterDesc, FovAxis};
 use glam::{Vec2, Vec3};
 
@@ -64,11 +65,11 @@ impl Camera {
 
     /// Sub-pixel offset from the pixel centre, distributed like the filter.
     #[inline]
-    fn filter_offset(&self, rng: &mut Rng) -> Vec2 {
+    fn filter_offset(&self, sampler: &mut impl Sampler) -> Vec2 {
         match self.filter {
-            FilterDesc::Box => rng.next_2d() - Vec2::splat(0.5),
+            FilterDesc::Box => sampler.film() - Vec2::splat(0.5),
             FilterDesc::Tent { radius } => {
-                crate::sampling::warps::square_to_tent(rng.next_2d()) * radius
+                crate::sampling::warps::square_to_tent(sampler.film()) * radius
             }
             FilterDesc::Gaussian { stddev, radius } => {
                 // Each axis by inverting the CDF of the Gaussian truncated to the radius: the
@@ -77,7 +78,7 @@ impl Camera {
                 use crate::sampling::erf::{erf, erfinv};
                 let s = std::f32::consts::SQRT_2 * stddev;
                 let e = erf(radius / s);
-                let u = rng.next_2d();
+                let u = sampler.film();
                 let inv = |u: f32| (s * erfinv((2.0 * u - 1.0) * e)).clamp(-radius, radius);
                 Vec2::new(inv(u.x), inv(u.y))
             }
@@ -86,8 +87,8 @@ impl Camera {
 
     /// The camera ray for one sample of pixel (px, py); image y grows downwards.
     #[inline]
-    pub fn generate_ray(&self, px: u32, py: u32, rng: &mut Rng) -> Ray {
-        let off = self.filter_offset(rng);
+    pub fn generate_ray(&self, px: u32, py: u32, sampler: &mut impl Sampler) -> Ray {
+        let off = self.filter_offset(sampler);
         let (fx, fy) = (px as f32 + 0.5 + off.x, py as f32 + 0.5 + off.y);
         let d = self.direction(fx, fy);
         let len = d.length();
@@ -113,12 +114,12 @@ impl Camera {
     /// (x*x + y*y) + z*z), so every ray is bitwise the one `generate_ray` gives, computed
     /// eight at a time.
     #[inline]
-    pub fn generate_rays(&self, px: u32, py: u32, rng: &mut RngLanes) -> RayPacket {
+    pub fn generate_rays<L: SamplerLanes>(&self, px: u32, py: u32, rng: &mut L) -> RayPacket {
         let (ox, oy) = match self.filter {
-            FilterDesc::Box => (
-                rng.next_f32().map(|u| u - 0.5),
-                rng.next_f32().map(|u| u - 0.5),
-            ),
+            FilterDesc::Box => {
+                let [ux, uy] = rng.film();
+                (ux.map(|u| u - 0.5), uy.map(|u| u - 0.5))
+            }
             _ => {
                 let (mut ox, mut oy) = ([0.0; LANES], [0.0; LANES]);
                 for i in 0..LANES {
@@ -157,6 +158,8 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::Rng;
+    use crate::sampler::IndependentLanes;
 
     fn camera(fov_axis: FovAxis, w: u32, h: u32) -> Camera {
         let desc = CameraDesc {
@@ -386,7 +389,7 @@ mod tests {
             );
             for (px, py, s0) in [(0, 0, 0), (96, 60, 8), (13, 47, 4096)] {
                 let key = Rng::pixel_key(11, py as u64 * 97 + px as u64);
-                let mut lanes = RngLanes::for_pixel_samples(key, s0);
+                let mut lanes = IndependentLanes::for_pixel_samples(key, s0);
                 let rays = c.generate_rays(px, py, &mut lanes);
                 for i in 0..LANES {
                     let r = &rays.ray(i);

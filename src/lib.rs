@@ -21,6 +21,7 @@ pub mod plot;
 pub mod render;
 pub mod report;
 pub mod rng;
+pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod stats;

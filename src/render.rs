@@ -3,7 +3,8 @@
 
 use crate::film::Image;
 use crate::integrator::{Direct, LaneScratch, Strategy};
-use crate::rng::{Rng, RngLanes, LANES};
+use crate::rng::LANES;
+use crate::sampler::{IndependentLanes, SamplerLanes};
 use crate::scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -165,7 +166,9 @@ fn is_finite(v: glam::Vec3) -> bool {
     (v.x - v.x) + (v.y - v.y) + (v.z - v.z) == 0.0
 }
 
-fn render_pixel(
+/// One pixel's samples, drawn by the sampler `L` (the render's only one so far is
+/// `independent`).
+fn render_pixel<L: SamplerLanes>(
     direct: &Direct,
     x: u32,
     y: u32,
@@ -176,13 +179,13 @@ fn render_pixel(
     let pixel = y as u64 * cam.width as u64 + x as u64;
     let mut stats = PixelStats::default();
     let mut non_finite = 0;
-    let key = Rng::pixel_key(settings.seed, pixel);
+    let key = L::pixel(settings.seed, pixel);
     // Samples go LANES at a time: their generators and camera rays are computed side by side
     // in vector registers, and `li_lanes` shades them together where it covers the scene;
     // each sample stays bitwise what `for_pixel_sample`, `generate_ray` and `li` give it
     // (lanes past spp are dropped).
     for s0 in (0..settings.spp).step_by(LANES) {
-        let mut lanes = RngLanes::for_pixel_samples(key, settings.first_sample + s0 as u64);
+        let mut lanes = L::start(key, settings.first_sample + s0 as u64);
         let rays = cam.generate_rays(x, y, &mut lanes);
         let n = (settings.spp - s0).min(LANES as u32) as usize;
         let values = direct.li_lanes(&rays, n, &mut lanes, scratch);
@@ -209,7 +212,7 @@ pub fn render_rows(
 ) -> f64 {
     let w = direct.scene.camera.width;
     rows.flat_map(|y| (0..w).map(move |x| (x, y)))
-        .map(|(x, y)| render_pixel(direct, x, y, settings, scratch).mean[0])
+        .map(|(x, y)| render_pixel::<IndependentLanes>(direct, x, y, settings, scratch).mean[0])
         .sum()
 }
 
@@ -250,7 +253,8 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
                 let mut scratch = LaneScratch::default();
                 for y in y0..(y0 + TILE).min(h) {
                     for x in x0..(x0 + TILE).min(w) {
-                        let r = render_pixel(&direct, x, y, settings, &mut scratch);
+                        let r =
+                            render_pixel::<IndependentLanes>(&direct, x, y, settings, &mut scratch);
                         out.push((x, y, r));
                     }
                 }
@@ -283,6 +287,7 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::Rng;
     use glam::Vec3;
 
     #[test]

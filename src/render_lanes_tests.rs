@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::emitter::EmitterSelection;
+use crate::rng::Rng;
 use crate::scene::desc::{Heuristic, StrategyKind};
 use glam::Vec3;
 

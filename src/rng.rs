@@ -73,6 +73,18 @@ impl Rng {
         }
     }
 
+    /// The generator at `state` of the stream `inc` (odd), for the lane samplers that step
+    /// many of them together.
+    #[inline(always)]
+    pub(crate) fn from_parts(state: u64, inc: u64) -> Self {
+        Rng { state, inc }
+    }
+
+    #[inline(always)]
+    pub(crate) fn state(&self) -> u64 {
+        self.state
+    }
+
     #[inline]
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;
@@ -105,54 +117,6 @@ impl Rng {
 /// Samples drawn side by side: camera samples are started this many at a time.
 pub const LANES: usize = 8;
 
-/// `LANES` per-sample generators stepped together, lane i being `for_pixel_sample(key, s0 + i)`.
-/// Plain loops over arrays, which the compiler turns into vector instructions: the seeding
-/// (64-bit multiplications) and the camera's draws cost about an eighth.
-///
-/// Cache-line aligned, its states first, as `PacketHits`: they are one 64-byte vector.
-#[derive(Clone)]
-#[repr(C, align(64))]
-pub struct RngLanes {
-    state: [u64; LANES],
-    /// The pixel's stream, shared by its samples.
-    inc: u64,
-}
-
-impl RngLanes {
-    #[inline]
-    pub fn for_pixel_samples(pixel_key: u64, s0: u64) -> Self {
-        let inc = Rng::pixel_stream(pixel_key);
-        let state =
-            std::array::from_fn(|i| Rng::in_pixel_stream(inc, pixel_key, s0 + i as u64).state);
-        RngLanes { state, inc }
-    }
-
-    #[inline]
-    pub fn next_f32(&mut self) -> [f32; LANES] {
-        let mut out = [0.0; LANES];
-        for (i, o) in out.iter_mut().enumerate() {
-            let mut r = self.lane(i);
-            *o = r.next_f32();
-            self.state[i] = r.state;
-        }
-        out
-    }
-
-    /// Lane i's generator, at the point the lanes have reached.
-    #[inline]
-    pub fn lane(&self, i: usize) -> Rng {
-        Rng {
-            state: self.state[i],
-            inc: self.inc,
-        }
-    }
-
-    #[inline]
-    pub fn set_lane(&mut self, i: usize, r: &Rng) {
-        self.state[i] = r.state;
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -172,21 +136,6 @@ mod tests {
             let mut a = Rng::for_sample(seed, pixel, s);
             let mut b = Rng::for_pixel_sample(Rng::pixel_key(seed, pixel), s);
             assert!((0..8).all(|_| a.next_u32() == b.next_u32()));
-        }
-    }
-
-    #[test]
-    fn lanes_are_the_per_sample_generators() {
-        for (key, s0) in [(0, 0), (Rng::pixel_key(7, 123), 8), (u64::MAX, 1 << 40)] {
-            let mut lanes = RngLanes::for_pixel_samples(key, s0);
-            let mut one: Vec<Rng> = (0..LANES as u64)
-                .map(|i| Rng::for_pixel_sample(key, s0 + i))
-                .collect();
-            for _ in 0..5 {
-                let l = lanes.next_f32();
-                assert!((0..LANES).all(|i| l[i] == one[i].next_f32()));
-            }
-            assert!((0..LANES).all(|i| lanes.lane(i).next_u32() == one[i].next_u32()));
         }
     }
 

@@ -15,7 +15,7 @@ use crate::bsdf::{BsdfSample, Material};
 use crate::emitter::{EmitterSelector, LightSample};
 use crate::geometry::{Hit, Ray, SurfacePoint};
 use crate::math::{Frame, Rgb};
-use crate::rng::Rng;
+use crate::sampler::Sampler;
 use crate::scene::desc::{Heuristic, StrategyKind};
 use crate::scene::Scene;
 use glam::Vec3;
@@ -63,7 +63,7 @@ impl<'a> Direct<'a> {
     }
 
     /// Radiance along a camera ray.
-    pub fn li(&self, ray: &Ray, rng: &mut Rng) -> Rgb {
+    pub fn li(&self, ray: &Ray, rng: &mut impl Sampler) -> Rgb {
         match self.scene.intersect(ray) {
             Some(hit) => self.li_hit(ray, &hit.sp, rng),
             None => Rgb::ZERO,
@@ -71,7 +71,7 @@ impl<'a> Direct<'a> {
     }
 
     /// `li` given the camera ray's hit.
-    pub(super) fn li_hit(&self, ray: &Ray, sp: &SurfacePoint, rng: &mut Rng) -> Rgb {
+    pub(super) fn li_hit(&self, ray: &Ray, sp: &SurfacePoint, rng: &mut impl Sampler) -> Rgb {
         let scene = self.scene;
         let sp = *sp;
         let mut l = Rgb::ZERO;
@@ -145,7 +145,7 @@ impl<'a> Direct<'a> {
             StrategyKind::MisOneSample => {
                 let c_light = if delta_bsdf { 0.0 } else { ne / (ne + nb) };
                 let c_bsdf = 1.0 - c_light;
-                if rng.next_f32() < c_light {
+                if rng.technique() < c_light {
                     l += self.light_sample(&sh, rng, |pl, pb| {
                         heuristic(s.heuristic, c_light * pl, c_bsdf * pb) / c_light
                     });
@@ -163,23 +163,27 @@ impl<'a> Direct<'a> {
     /// technique's selection probability; a delta light is asked with p_bsdf = 0, since no
     /// other technique can produce it.
     #[inline]
-    fn light_sample(&self, sh: &Shading, rng: &mut Rng, weight: impl Fn(f32, f32) -> f32) -> Rgb {
+    fn light_sample(
+        &self,
+        sh: &Shading,
+        rng: &mut impl Sampler,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
         let drawn = self.light_draw(sh, rng);
         self.light_finish(sh, drawn, weight)
     }
 
     /// The random half of a light sample: the emitter, its point and density.
     #[inline(always)]
-    fn light_draw(&self, sh: &Shading, rng: &mut Rng) -> Option<(LightSample, f32)> {
+    fn light_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<(LightSample, f32)> {
         let scene = self.scene;
-        let (ei, pmf) = self.selector.sample(rng.next_f32())?;
-        let u_prim = rng.next_f32();
-        let u = rng.next_2d();
+        let u = rng.light();
+        let (ei, pmf) = self.selector.sample(u.select)?;
         let ls = scene.emitters[ei].sample(
             &scene.shapes,
             sh.sp.p,
-            u_prim,
-            u,
+            u.primitive,
+            u.point,
             self.strategy.light_sampling,
         )?;
         Some((ls, pmf))
@@ -213,17 +217,21 @@ impl<'a> Direct<'a> {
     /// One BSDF-technique sample: follow the sampled direction and collect emission there.
     /// Delta lobes are asked for their weight with p_light = 0 (light sampling cannot hit them).
     #[inline]
-    fn bsdf_sample(&self, sh: &Shading, rng: &mut Rng, weight: impl Fn(f32, f32) -> f32) -> Rgb {
+    fn bsdf_sample(
+        &self,
+        sh: &Shading,
+        rng: &mut impl Sampler,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
         let drawn = self.bsdf_draw(sh, rng);
         self.bsdf_finish(sh, drawn, weight)
     }
 
     /// The random half of a BSDF sample.
     #[inline(always)]
-    fn bsdf_draw(&self, sh: &Shading, rng: &mut Rng) -> Option<BsdfSample> {
-        let u1 = rng.next_f32();
-        let u2 = rng.next_2d();
-        sh.mat.sample(sh.wi, u1, u2)
+    fn bsdf_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<BsdfSample> {
+        let u = rng.bsdf();
+        sh.mat.sample(sh.wi, u.lobe, u.direction)
     }
 
     /// The rest of a BSDF sample: its ray, the emitter it reaches and the weight.

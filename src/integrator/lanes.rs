@@ -26,7 +26,8 @@ use crate::bsdf::{BsdfSample, Diffuse};
 use crate::geometry::ray_packet::bits;
 use crate::geometry::{Accel, PacketHits, RayPacket};
 use crate::math::{Frame, Rgb};
-use crate::rng::{RngLanes, LANES};
+use crate::rng::LANES;
+use crate::sampler::SamplerLanes;
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 
@@ -152,11 +153,11 @@ impl Direct<'_> {
     /// camera's draws half in one 32-byte store, half in 8-byte ones) and returned the
     /// estimates through memory, both read back at once by loads too wide to be forwarded.
     #[inline(always)]
-    pub fn li_lanes(
+    pub fn li_lanes<L: SamplerLanes>(
         &self,
         rays: &RayPacket,
         n: usize,
-        rng: &mut RngLanes,
+        rng: &mut L,
         scratch: &mut LaneScratch,
     ) -> [Rgb; LANES] {
         let Some(lanes) = &self.lanes else {
@@ -176,7 +177,9 @@ impl Direct<'_> {
         // that lanes left to `li_hit` do not see: placed after, their chain of dependent
         // 64-bit multiplications (about 15 cycles each) started only once traversal ended.
         let at_hit = rng.clone();
-        let u: [[f32; LANES]; 7] = std::array::from_fn(|_| rng.next_f32());
+        let [u0, u1, u2, u3] = rng.light();
+        let [u4, u5, u6] = rng.bsdf();
+        let u = [u0, u1, u2, u3, u4, u5, u6];
         self.scene
             .intersect8_into(rays, (1 << n) - 1, &mut hits.camera);
         self.camera_hits(&lanes.shapes, rays, &at_hit, &mut out, hits);
@@ -204,11 +207,11 @@ impl Direct<'_> {
     /// The camera rays' hits into lanes; lanes the kernel does not cover are finished here
     /// by `li_hit`.
     #[inline(always)]
-    fn camera_hits(
+    fn camera_hits<L: SamplerLanes>(
         &self,
         shapes: &[LaneShape],
         rays: &RayPacket,
-        rng: &RngLanes,
+        rng: &L,
         out: &mut [Rgb; LANES],
         h: &mut CameraHits,
     ) {

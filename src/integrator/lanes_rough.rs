@@ -244,7 +244,8 @@ mod tests {
     use crate::bsdf::BsdfKind;
     use crate::geometry::{Ray, RayPacket};
     use crate::integrator::{Direct, Strategy};
-    use crate::rng::{Rng, RngLanes, LANES};
+    use crate::rng::{Rng, LANES};
+    use crate::sampler::IndependentLanes;
     use crate::sampling::microfacet::ITERS;
     use crate::scene::desc::StrategyKind;
     use crate::scene::Scene;
@@ -339,7 +340,7 @@ mod tests {
         let mut scratch = crate::integrator::LaneScratch::default();
         ITERS.with(|c| c.set(0));
         for b in 0..batches {
-            let mut lanes = RngLanes::for_pixel_samples(9, 8 * b);
+            let mut lanes = IndependentLanes::for_pixel_samples(9, 8 * b);
             direct.li_lanes(&rays, LANES, &mut lanes, &mut scratch);
         }
         let per_batch = ITERS.with(|c| c.get()) as f64 / batches as f64;

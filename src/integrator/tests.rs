@@ -478,3 +478,93 @@ fn delta_paths_at_sample_counts_two_and_three() {
         }
     }
 }
+
+/// The estimator draws its sampler's groups in the order `crate::sampler` documents, for every
+/// strategy at 2 light and 3 BSDF samples: on a diffuse floor under an area light, a mirror
+/// floor (delta BSDF: BSDF groups in place of light groups) and a diffuse floor under a point
+/// light (BSDF sampling adds a light group per BSDF sample). 64 camera samples each, so that
+/// one-sample MIS picks both techniques.
+#[test]
+fn estimator_draws_the_documented_dimension_groups() {
+    use crate::bsdf::{BsdfKind, Mirror};
+    use crate::rng::Rng;
+    use crate::sampler::{BsdfDims, LightDims, Sampler};
+    use crate::scene::desc::PointLightDesc;
+    struct Recorder(Rng, String);
+    impl Sampler for Recorder {
+        fn film(&mut self) -> glam::Vec2 {
+            self.1.push('f');
+            self.0.film()
+        }
+        fn technique(&mut self) -> f32 {
+            self.1.push('t');
+            self.0.technique()
+        }
+        fn light(&mut self) -> LightDims {
+            self.1.push('L');
+            self.0.light()
+        }
+        fn bsdf(&mut self) -> BsdfDims {
+            self.1.push('B');
+            self.0.bsdf()
+        }
+    }
+    let eye = Vec3::new(0.0, -3.0, 3.0);
+    let light = fixtures::square_z(1.0, 2.0, false, fixtures::diffuse(0.0), Some(Vec3::ONE));
+    let diffuse = fixtures::light_over_floor(light.clone(), 0.5, Vec3::ZERO, eye);
+    let mut mirror = fixtures::light_over_floor(light, 0.5, Vec3::ZERO, eye);
+    mirror.shapes[0].bsdf = fixtures::one_sided(BsdfKind::Mirror(Mirror));
+    let mut point = fixtures::floor_probe(0.5, Vec3::ZERO, eye);
+    point.point_lights.push(PointLightDesc {
+        position: Vec3::new(0.0, 0.0, 2.0),
+        intensity: Vec3::ONE,
+        origin: "<test>".into(),
+    });
+    let mut one_sample_picks = (0, 0);
+    for (name, desc) in [("diffuse", diffuse), ("mirror", mirror), ("point", point)] {
+        let scene = Scene::build(desc).unwrap();
+        for s in all_strategies() {
+            let s = Strategy {
+                emitter_samples: 2,
+                bsdf_samples: 3,
+                ..s
+            };
+            let direct = super::Direct::new(&scene, s);
+            let want = match (s.kind, name) {
+                (StrategyKind::Light, "mirror") => "fBB",
+                (StrategyKind::Light, _) => "fLL",
+                (StrategyKind::Bsdf, "point") => "fBBBLLL",
+                (StrategyKind::Bsdf, _) => "fBBB",
+                (StrategyKind::Mis, "mirror") => "fBBB",
+                (StrategyKind::Mis, _) => "fLLBBB",
+                (StrategyKind::MisOneSample, "mirror") => "ftB",
+                (StrategyKind::MisOneSample, _) => "ft?",
+            };
+            for i in 0..64 {
+                let mut r = Recorder(Rng::for_sample(1, 0, i), String::new());
+                let ray = scene.camera.generate_ray(0, 0, &mut r);
+                direct.li(&ray, &mut r);
+                let got = r.1;
+                match want.strip_suffix('?') {
+                    Some(head) => {
+                        assert!(
+                            got == format!("{head}L") || got == format!("{head}B"),
+                            "{got}"
+                        );
+                        let picks = &mut one_sample_picks;
+                        *if got.ends_with('L') {
+                            &mut picks.0
+                        } else {
+                            &mut picks.1
+                        } += 1;
+                    }
+                    None => assert_eq!(got, want, "{} on the {name} floor", s.label()),
+                }
+            }
+        }
+    }
+    assert!(
+        one_sample_picks.0 > 0 && one_sample_picks.1 > 0,
+        "{one_sample_picks:?}"
+    );
+}
