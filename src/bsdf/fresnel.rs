@@ -76,6 +76,19 @@ pub fn fresnel_conductor_channel(cos_i: f32, eta: f32, k: f32) -> f32 {
     num / den
 }
 
+/// Mitsuba's diffuse Fresnel reflectance F_dr(eta): the fraction of uniformly diffuse light
+/// that a smooth boundary of index ratio `eta` reflects. Egan and Hilgeman's fit below 1,
+/// d'Eon and Irving's above (each where it is accurate to about 0.1 %).
+pub fn fresnel_diffuse_reflectance(eta: f32) -> f32 {
+    let inv = 1.0 / eta;
+    if eta < 1.0 {
+        0.0636 * inv + (eta * (eta * -1.4399 + 0.7099) + 0.6681)
+    } else {
+        let c = [0.919317, -3.4793, 6.75335, -7.80989, 4.98554, -1.36881];
+        c.iter().rev().fold(0.0, |acc, &k| acc * inv + k)
+    }
+}
+
 /// The largest index component the loader takes: the f32 form's squares and products stay
 /// far from overflow (k^4 ~ 1e24).
 pub const MAX_INDEX: f32 = 1e6;

@@ -11,6 +11,7 @@ pub mod fresnel;
 mod mirror;
 mod nori_microfacet;
 pub mod params;
+mod plastic;
 mod roughconductor;
 
 pub use conductor::Conductor;
@@ -18,6 +19,7 @@ pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
 pub use mirror::Mirror;
 pub use nori_microfacet::NoriMicrofacet;
+pub use plastic::Plastic;
 pub use roughconductor::RoughConductor;
 
 use crate::math::Rgb;
@@ -39,6 +41,10 @@ pub struct BsdfSample {
 pub trait Bsdf: Sized {
     /// Every lobe is a Dirac delta: `eval` and `pdf` are 0, `sample` gives the lobes.
     const DELTA: bool;
+    /// Some lobe is a Dirac delta (every lobe for a `DELTA` BSDF; the coating of `plastic`).
+    /// Light sampling cannot produce its directions, so the light strategy adds BSDF samples
+    /// for them.
+    const DELTA_LOBE: bool = Self::DELTA;
     /// Whether `twosided` may wrap it (not for a BSDF that gives both sides a meaning).
     const TWO_SIDED: bool = true;
     /// Reads Mitsuba's (or Nori's) parameters of its `<bsdf>` element.
@@ -86,6 +92,12 @@ macro_rules! registry {
             pub fn is_delta(&self) -> bool {
                 match self {
                     $(BsdfKind::$variant(_) => <$ty as Bsdf>::DELTA,)*
+                }
+            }
+
+            pub fn has_delta_lobe(&self) -> bool {
+                match self {
+                    $(BsdfKind::$variant(_) => <$ty as Bsdf>::DELTA_LOBE,)*
                 }
             }
 
@@ -141,6 +153,7 @@ registry! {
     Dielectric(Dielectric) = "dielectric";
     NoriMicrofacet(NoriMicrofacet) = "microfacet";
     Mirror(Mirror) = "mirror";
+    Plastic(Plastic) = "plastic";
 }
 
 /// A material: a BSDF and whether it is used on both sides of the surface.
@@ -164,6 +177,11 @@ impl Material {
     /// True if every lobe is a Dirac delta (light sampling is then useless).
     pub fn is_delta(&self) -> bool {
         self.kind.is_delta()
+    }
+
+    /// True if some lobe is a Dirac delta (then light sampling misses its paths).
+    pub fn has_delta_lobe(&self) -> bool {
+        self.kind.has_delta_lobe()
     }
 
     #[inline]

@@ -9,7 +9,7 @@
 use super::checks::WeightCheck;
 use super::lobe::{reflection_window, run_windowed};
 use super::{Case, CaseConfig, Outcome};
-use crate::bsdf::{BsdfKind, Diffuse, Material, NoriMicrofacet, RoughConductor};
+use crate::bsdf::{BsdfKind, Diffuse, Material, NoriMicrofacet, Plastic, RoughConductor};
 use crate::math::Rgb;
 use crate::rng::Rng;
 use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
@@ -117,6 +117,17 @@ pub fn materials() -> Vec<Entry> {
             false,
             Some((a, a)),
         ));
+    }
+    // Plastic's coating is a delta lobe (counted as lost); the diffuse lobe's mass is its
+    // probability, which depends on the incidence through the Fresnel term.
+    for (eta, nonlinear) in [(1.49f32, false), (2.0, true)] {
+        let kind = BsdfKind::Plastic(Plastic::new(
+            eta,
+            Rgb::new(0.2, 0.5, 0.9),
+            Rgb::splat(0.8),
+            nonlinear,
+        ));
+        v.push(entry(format!("plastic-eta{eta}"), kind, false, None));
     }
     v
 }

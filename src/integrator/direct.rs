@@ -5,9 +5,9 @@
 //! MIS weights each technique with h(n_i p_i, n_j p_j) (Veach's heuristics); one-sample MIS
 //! picks a technique with probability c_i and weights by h(c_i p_i, c_j p_j) / c_i.
 //!
-//! Paths only one technique can produce (delta BSDFs: BSDF sampling only; delta lights: light
-//! sampling only) are handled by that technique with weight 1 in every strategy, including
-//! the pure ones, so no strategy loses them and none counts them twice.
+//! Paths only one technique can produce (delta BSDFs and delta lobes: BSDF sampling only;
+//! delta lights: light sampling only) are handled by that technique with weight 1 in every
+//! strategy, including the pure ones, so no strategy loses them and none counts them twice.
 
 use super::lane_tables::{lane_setup, Lanes};
 use super::Strategy;
@@ -103,8 +103,14 @@ impl<'a> Direct<'a> {
                 }
             }
             StrategyKind::Light => {
+                // A delta lobe beside lobes with a density (plastic's coating): light samples
+                // for the latter, and a BSDF sample each that counts only the delta lobe.
+                let delta_lobe = sh.mat.has_delta_lobe();
                 for _ in 0..s.emitter_samples {
                     l += self.light_sample(&sh, rng, |_, _| 1.0) / ne;
+                    if delta_lobe {
+                        l += self.bsdf_sample(&sh, rng, only_other) / ne;
+                    }
                 }
             }
             StrategyKind::Bsdf => {

@@ -26,7 +26,9 @@
 //! picked. A group a sample does not use (a light sample whose emitter choice failed) is
 //! still drawn whole, so later groups keep their place.
 //!
-//! A delta BSDF (light samples would add 0) draws a BSDF group in place of each light group.
+//! A delta BSDF (light samples would add 0) draws a BSDF group in place of each light group;
+//! under light sampling, a BSDF with a delta lobe beside others (`plastic`) draws a BSDF group
+//! after each light group, for the paths only its delta lobe makes.
 
 pub mod independent;
 

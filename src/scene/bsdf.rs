@@ -19,7 +19,6 @@ pub(crate) fn supported_bsdfs() -> Vec<&'static str> {
 }
 
 const KNOWN_BSDFS: &[&str] = &[
-    "plastic",
     "roughplastic",
     "roughdielectric",
     "thindielectric",
@@ -256,7 +255,19 @@ pub(crate) mod tests {
                 r#"<bsdf type="diffuse"><float name="roughness" value="0.5"/></bsdf>"#,
                 "roughness",
             ),
-            (r#"<bsdf type="plastic"/>"#, "not supported yet"),
+            (r#"<bsdf type="roughplastic"/>"#, "not supported yet"),
+            (
+                r#"<bsdf type="plastic"><rgb name="diffuse_reflectance" value="0"/><rgb name="specular_reflectance" value="0"/></bsdf>"#,
+                "both black",
+            ),
+            (
+                r#"<bsdf type="plastic"><string name="int_ior" value="glass"/></bsdf>"#,
+                "unknown IOR name",
+            ),
+            (
+                r#"<bsdf type="plastic"><boolean name="nonlinear" value="maybe"/></bsdf>"#,
+                "nonlinear",
+            ),
             (r#"<bsdf type="velvet"/>"#, "unknown bsdf type 'velvet'"),
         ];
         for (bsdf, words) in cases {

@@ -3,7 +3,7 @@
 
 use super::tests::{m3, m3_err, shape_bsdf};
 use crate::bsdf::{
-    BsdfKind, Conductor, Dielectric, Diffuse, Material, NoriMicrofacet, RoughConductor,
+    BsdfKind, Conductor, Dielectric, Diffuse, Material, NoriMicrofacet, Plastic, RoughConductor,
 };
 use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
 use glam::Vec3;
@@ -160,6 +160,29 @@ fn bsdf_parameters_and_defaults() {
         ),
         dielectric(2.419, 1.0)
     );
+    let one_sided = |p: Plastic| one(BsdfKind::Plastic(p));
+    assert_eq!(
+        b(r#"<bsdf type="plastic"/>"#),
+        one_sided(Plastic::new(
+            1.49 / 1.000277,
+            Vec3::splat(0.5),
+            Vec3::ONE,
+            false
+        ))
+    );
+    assert_eq!(
+        b(
+            r#"<bsdf type="plastic"><string name="int_ior" value="bk7"/><float name="ext_ior" value="1.1"/>
+             <rgb name="diffuse_reflectance" value="0.1, 0.2, 0.3"/>
+             <float name="specular_reflectance" value="0.7"/><boolean name="nonlinear" value="true"/></bsdf>"#
+        ),
+        one_sided(Plastic::new(
+            1.5046 / 1.1,
+            Vec3::new(0.1, 0.2, 0.3),
+            Vec3::splat(0.7),
+            true
+        ))
+    );
 
     let e =
         m3_err(r#"<bsdf type="dielectric" id="g"><string name="int_ior" value="glassy"/></bsdf>"#);
@@ -182,14 +205,33 @@ fn bsdf_parameters_and_defaults() {
             "{e}"
         );
     }
-    let e = m3_err(r#"<bsdf type="plastic" id="p"/>"#);
+    let e = m3_err(r#"<bsdf type="roughplastic" id="p"/>"#);
     assert!(
         e.contains(
-            "test.xml:2: <bsdf type=\"plastic\" id=\"p\">: bsdf 'plastic' is not supported yet"
+            "test.xml:2: <bsdf type=\"roughplastic\" id=\"p\">: bsdf 'roughplastic' is not supported yet"
         ),
         "{e}"
     );
     let e =
         m3_err(r#"<bsdf type="diffuse" id="d"><texture type="bitmap" name="reflectance"/></bsdf>"#);
     assert!(e.contains("texture 'bitmap' is not supported yet"), "{e}");
+}
+
+/// A plastic whose Mitsuba fits make it reflect more than it receives is read, with a
+/// warning that says how much and why; the default plastic reads without one.
+#[test]
+fn plastic_that_creates_energy_is_named_in_a_warning() {
+    let hot = m3(
+        r#"<shape type="rectangle"><bsdf type="plastic"><float name="int_ior" value="3"/>
+         <rgb name="diffuse_reflectance" value="1"/></bsdf></shape>"#,
+    );
+    assert!(
+        hot.warnings.iter().any(|w| w.contains("test.xml:")
+            && w.contains("reflects 1.18")
+            && w.contains("plastic")),
+        "{:?}",
+        hot.warnings
+    );
+    let fine = m3(r#"<shape type="rectangle"><bsdf type="plastic"/></shape>"#);
+    assert!(fine.warnings.is_empty(), "{:?}", fine.warnings);
 }
