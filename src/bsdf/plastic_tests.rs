@@ -204,6 +204,7 @@ type MitsubaRow = (
     f32,
 );
 // Mitsuba 3.9.1 scalar_rgb: (int_ior, d, s, nonlinear, cos_i, phi_i, cos_o, phi_o, eval, pdf, specular weight, specular probability)
+#[allow(clippy::excessive_precision)] // as Mitsuba printed them
 const MITSUBA_PLASTIC: &[MitsubaRow] = &[
     (
         1.49,

@@ -394,3 +394,32 @@ fn eval_albedo_matches_mitsuba_at_high_roughness() {
     }
     eprintln!("rough conductor albedo vs Mitsuba 3: worst difference {worst:.1e}");
 }
+
+/// specular_reflectance scales eval and the sample weight channel by channel (and leaves the
+/// pdf and the sampled direction alone).
+#[test]
+fn specular_reflectance_scales_eval_and_weight() {
+    let spec = Rgb::new(0.5, 0.25, 0.8);
+    let wi = Vec3::new(0.3, 0.2, 0.9).normalize();
+    let wo = Vec3::new(-0.4, -0.1, 0.8).normalize();
+    for d in DISTS {
+        let (white, tinted) = (
+            rough(d, (0.3, 0.3), true, Rgb::ONE),
+            rough(d, (0.3, 0.3), true, spec),
+        );
+        let (e1, e2) = (white.eval(wi, wo), tinted.eval(wi, wo));
+        assert!(e1.min_element() > 0.0);
+        assert!(
+            (e2 - e1 * spec).abs().max_element() <= 1e-6 * e1.max_element(),
+            "{e1} {e2}"
+        );
+        assert_eq!(white.pdf(wi, wo), tinted.pdf(wi, wo));
+        let (s1, s2) = (
+            white.sample(wi, 0.3, Vec2::new(0.4, 0.6)).unwrap(),
+            tinted.sample(wi, 0.3, Vec2::new(0.4, 0.6)).unwrap(),
+        );
+        assert_eq!(s1.wo, s2.wo);
+        let w = s1.weight * spec;
+        assert!((s2.weight - w).abs().max_element() <= 1e-6 * w.max_element());
+    }
+}

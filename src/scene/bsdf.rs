@@ -203,6 +203,53 @@ pub(crate) mod tests {
         assert!(m.two_sided && m.kind.type_name() == "roughconductor");
     }
 
+    /// What a BSDF's defaults are (`BsdfKind::parse` with `Defaults`, which the tests of
+    /// the registry use) is what the scene reader makes of an element with no parameters.
+    #[test]
+    fn defaults_are_an_empty_element() {
+        use crate::bsdf::{params::Defaults, BsdfKind};
+        for ty in REGISTERED {
+            let m = read(&format!(r#"<bsdf type="{ty}"/>"#)).unwrap();
+            let d = BsdfKind::parse(ty, &mut Defaults).unwrap().unwrap();
+            assert_eq!(m.kind, d, "{ty}");
+        }
+    }
+
+    /// A reflectance of exactly 1 is quiet, above 1 (in one channel) warned; an index
+    /// component of exactly the largest accepted is read.
+    #[test]
+    fn reflectance_warnings_and_index_bounds() {
+        let warnings = |bsdf: &str| {
+            let xml = format!(
+                r#"<scene version="3.0.0"><sensor type="perspective"/>
+                   <shape type="rectangle">{bsdf}</shape>
+                   <emitter type="point"><point name="position" x="0" y="0" z="1"/></emitter>
+                   </scene>"#
+            );
+            load_scene_str(&xml, Path::new("t.xml"), &[])
+                .unwrap()
+                .warnings
+        };
+        let quiet = r#"<bsdf type="diffuse"><rgb name="reflectance" value="1, 0.5, 0"/></bsdf>"#;
+        assert!(warnings(quiet).is_empty(), "{:?}", warnings(quiet));
+        let loud = r#"<bsdf type="diffuse"><rgb name="reflectance" value="0.2, 1.2, 0"/></bsdf>"#;
+        assert!(
+            warnings(loud).iter().any(|w| w.contains("reflectance")),
+            "{:?}",
+            warnings(loud)
+        );
+        let max = crate::bsdf::fresnel::MAX_INDEX;
+        let edge = format!(
+            r#"<bsdf type="conductor"><rgb name="eta" value="{max}"/><rgb name="k" value="{max}"/></bsdf>"#
+        );
+        read(&edge).unwrap_or_else(|e| panic!("{e}"));
+        let over = format!(
+            r#"<bsdf type="conductor"><rgb name="eta" value="1"/><rgb name="k" value="{}"/></bsdf>"#,
+            max * 1.01
+        );
+        assert!(read(&over).unwrap_err().contains("must lie in"));
+    }
+
     /// Bad parameters end in an error that names the element's line and the problem.
     #[test]
     fn bad_parameters_are_refused_with_the_reason() {
@@ -256,6 +303,18 @@ pub(crate) mod tests {
                 "roughness",
             ),
             (r#"<bsdf type="roughplastic"/>"#, "not supported yet"),
+            (
+                r#"<bsdf type="plastic"><float name="int_ior" value="0"/></bsdf>"#,
+                "int_ior must be positive",
+            ),
+            (
+                r#"<bsdf type="microfacet"><float name="alpha" value="0"/></bsdf>"#,
+                "alpha) must be positive",
+            ),
+            (
+                r#"<bsdf type="conductor"><string name="material" value="Au"/><rgb name="eta" value="1"/><rgb name="k" value="1"/></bsdf>"#,
+                "not both",
+            ),
             (
                 r#"<bsdf type="plastic"><rgb name="diffuse_reflectance" value="0"/><rgb name="specular_reflectance" value="0"/></bsdf>"#,
                 "both black",
