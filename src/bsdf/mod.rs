@@ -13,6 +13,7 @@ mod nori_microfacet;
 pub mod params;
 mod plastic;
 mod roughconductor;
+mod roughplastic;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
@@ -21,6 +22,7 @@ pub use mirror::Mirror;
 pub use nori_microfacet::NoriMicrofacet;
 pub use plastic::Plastic;
 pub use roughconductor::RoughConductor;
+pub use roughplastic::RoughPlastic;
 
 use crate::math::Rgb;
 use glam::{Vec2, Vec3};
@@ -154,6 +156,7 @@ registry! {
     NoriMicrofacet(NoriMicrofacet) = "microfacet";
     Mirror(Mirror) = "mirror";
     Plastic(Plastic) = "plastic";
+    RoughPlastic(RoughPlastic) = "roughplastic";
 }
 
 /// A material: a BSDF and whether it is used on both sides of the surface.

@@ -4,6 +4,7 @@
 //! several share: named indices of refraction, conductor indices, reflectance checks.
 
 use crate::math::Rgb;
+use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
 use glam::Vec3;
 
 /// A BSDF's parameters, read by name. Every read marks the name as used; what is given and
@@ -212,6 +213,55 @@ pub fn roughness<P: Params>(p: &mut P, name: &'static str, default: f32) -> Resu
     } else {
         Err(p.error(Some(name), "roughness (alpha) must be positive".to_string()))
     }
+}
+
+/// A microfacet lobe's `distribution` (beckmann, ggx; default beckmann), `alpha` or
+/// `alpha_u` and `alpha_v` (default 0.1) and `sample_visible` (default true), as Mitsuba's
+/// rough plugins read them.
+pub fn microfacet<P: Params>(p: &mut P) -> Result<(Microfacet, bool), P::Error> {
+    let distribution = match p.string("distribution")? {
+        None => MicrofacetDistribution::Beckmann,
+        Some(s) => match s.to_ascii_lowercase().as_str() {
+            "beckmann" => MicrofacetDistribution::Beckmann,
+            "ggx" => MicrofacetDistribution::Ggx,
+            "phong" | "as" => {
+                return Err(p.error(
+                    Some("distribution"),
+                    format!("microfacet distribution \"{s}\" is not supported yet"),
+                ))
+            }
+            _ => {
+                return Err(p.error(
+                    Some("distribution"),
+                    format!("expected distribution \"beckmann\" or \"ggx\", found \"{s}\""),
+                ))
+            }
+        },
+    };
+    let alpha = p.float("alpha")?;
+    let alpha_u = p.float("alpha_u")?;
+    let alpha_v = p.float("alpha_v")?;
+    let (alpha_u, alpha_v) = match (alpha, alpha_u, alpha_v) {
+        (Some(a), None, None) => (a, a),
+        (None, Some(u), Some(v)) => (u, v),
+        (None, None, None) => (0.1, 0.1),
+        (Some(_), _, _) => {
+            return Err(p.error(
+                None,
+                "give either 'alpha' or 'alpha_u'/'alpha_v', not both".into(),
+            ))
+        }
+        _ => return Err(p.error(None, "give both 'alpha_u' and 'alpha_v'".into())),
+    };
+    if !(alpha_u > 0.0 && alpha_v > 0.0 && alpha_u.is_finite() && alpha_v.is_finite()) {
+        return Err(p.error(None, "roughness (alpha) must be positive".into()));
+    }
+    // Mitsuba 0.6 has no such flag; it always sampled visible normals.
+    let sample_visible = p.boolean("sample_visible")?.unwrap_or(true);
+    Ok((
+        Microfacet::new(distribution, alpha_u, alpha_v),
+        sample_visible,
+    ))
 }
 
 /// No parameter given: a BSDF with its defaults (`BsdfKind::parse(ty, &mut Defaults)`).

@@ -17,7 +17,6 @@ use super::Bsdf;
 use super::BsdfSample;
 use crate::math::Rgb;
 use crate::sampling::microfacet::Microfacet;
-use crate::sampling::microfacet::MicrofacetDistribution;
 use glam::{DVec3, Vec2, Vec3};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -157,47 +156,9 @@ impl Bsdf for RoughConductor {
     /// and `specular_reflectance`.
     fn from_params<P: Params>(p: &mut P) -> Result<Self, P::Error> {
         let (eta, k, specular_reflectance) = params::conductor(p)?;
-        let distribution = match p.string("distribution")? {
-            None => MicrofacetDistribution::Beckmann,
-            Some(s) => match s.to_ascii_lowercase().as_str() {
-                "beckmann" => MicrofacetDistribution::Beckmann,
-                "ggx" => MicrofacetDistribution::Ggx,
-                "phong" | "as" => {
-                    return Err(p.error(
-                        Some("distribution"),
-                        format!("microfacet distribution \"{s}\" is not supported yet"),
-                    ))
-                }
-                _ => {
-                    return Err(p.error(
-                        Some("distribution"),
-                        format!("expected distribution \"beckmann\" or \"ggx\", found \"{s}\""),
-                    ))
-                }
-            },
-        };
-        let alpha = p.float("alpha")?;
-        let alpha_u = p.float("alpha_u")?;
-        let alpha_v = p.float("alpha_v")?;
-        let (alpha_u, alpha_v) = match (alpha, alpha_u, alpha_v) {
-            (Some(a), None, None) => (a, a),
-            (None, Some(u), Some(v)) => (u, v),
-            (None, None, None) => (0.1, 0.1),
-            (Some(_), _, _) => {
-                return Err(p.error(
-                    None,
-                    "give either 'alpha' or 'alpha_u'/'alpha_v', not both".into(),
-                ))
-            }
-            _ => return Err(p.error(None, "give both 'alpha_u' and 'alpha_v'".into())),
-        };
-        if !(alpha_u > 0.0 && alpha_v > 0.0 && alpha_u.is_finite() && alpha_v.is_finite()) {
-            return Err(p.error(None, "roughness (alpha) must be positive".into()));
-        }
-        // Mitsuba 0.6 has no such flag; it always sampled visible normals.
-        let sample_visible = p.boolean("sample_visible")?.unwrap_or(true);
+        let (mf, sample_visible) = params::microfacet(p)?;
         Ok(RoughConductor {
-            mf: Microfacet::new(distribution, alpha_u, alpha_v),
+            mf,
             sample_visible,
             eta,
             k,

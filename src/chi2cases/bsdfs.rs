@@ -9,7 +9,9 @@
 use super::checks::WeightCheck;
 use super::lobe::{reflection_window, run_windowed};
 use super::{Case, CaseConfig, Outcome};
-use crate::bsdf::{BsdfKind, Diffuse, Material, NoriMicrofacet, Plastic, RoughConductor};
+use crate::bsdf::{
+    BsdfKind, Diffuse, Material, NoriMicrofacet, Plastic, RoughConductor, RoughPlastic,
+};
 use crate::math::Rgb;
 use crate::rng::Rng;
 use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
@@ -128,6 +130,23 @@ pub fn materials() -> Vec<Entry> {
             nonlinear,
         ));
         v.push(entry(format!("plastic-eta{eta}"), kind, false, None));
+    }
+    // Rough plastic: a glossy coating over the diffuse base, both with a density.
+    for (d, a, visible) in [
+        (MicrofacetDistribution::Beckmann, 0.05f32, true),
+        (MicrofacetDistribution::Ggx, 0.3, false),
+    ] {
+        let dn = format!("{d:?}").to_lowercase();
+        let kind = BsdfKind::RoughPlastic(RoughPlastic::new(
+            Microfacet::new(d, a, a),
+            visible,
+            1.49,
+            Rgb::new(0.2, 0.5, 0.9),
+            Rgb::splat(0.8),
+            false,
+        ));
+        let name = format!("roughplastic-{dn}-a{a}");
+        v.push(entry(name, kind, false, Some((a, a))));
     }
     v
 }

@@ -3,6 +3,7 @@
 pub mod discrete;
 pub(crate) mod elementary;
 pub(crate) mod erf;
+pub mod gauss_legendre;
 pub mod microfacet;
 #[cfg(test)]
 pub(crate) mod quadrature;

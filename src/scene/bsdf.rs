@@ -19,7 +19,6 @@ pub(crate) fn supported_bsdfs() -> Vec<&'static str> {
 }
 
 const KNOWN_BSDFS: &[&str] = &[
-    "roughplastic",
     "roughdielectric",
     "thindielectric",
     "principled",
@@ -302,7 +301,15 @@ pub(crate) mod tests {
                 r#"<bsdf type="diffuse"><float name="roughness" value="0.5"/></bsdf>"#,
                 "roughness",
             ),
-            (r#"<bsdf type="roughplastic"/>"#, "not supported yet"),
+            (r#"<bsdf type="roughdielectric"/>"#, "not supported yet"),
+            (
+                r#"<bsdf type="roughplastic"><float name="alpha_u" value="0.1"/><float name="alpha_v" value="0.3"/></bsdf>"#,
+                "isotropic roughness only",
+            ),
+            (
+                r#"<bsdf type="roughplastic"><float name="int_ior" value="1.5"/><float name="ext_ior" value="1.5"/></bsdf>"#,
+                "must differ",
+            ),
             (
                 r#"<bsdf type="plastic"><float name="int_ior" value="0"/></bsdf>"#,
                 "int_ior must be positive",

@@ -113,6 +113,21 @@ fn cases(ty: &str) -> Vec<Case> {
         "mirror" => vec![case(r#"<bsdf type="mirror"/>"#, true, None)],
         // Not lossless even when white: the diffuse Fresnel fits leave white plastic 0.1 %
         // above or below 1 (the BSDF's own tests bound it).
+        "roughplastic" => {
+            let mut v = Vec::new();
+            for (dist, a) in [("beckmann", 0.05), ("ggx", 0.3), ("beckmann", 0.8)] {
+                v.push(case(
+                    format!(
+                        r#"<bsdf type="roughplastic"><string name="distribution" value="{dist}"/>
+                           <float name="alpha" value="{a}"/>
+                           <rgb name="diffuse_reflectance" value="0.9, 0.5, 0.2"/></bsdf>"#
+                    ),
+                    false,
+                    Some(a),
+                ));
+            }
+            v
+        }
         "plastic" => vec![
             case(r#"<bsdf type="plastic"/>"#, false, None),
             case(

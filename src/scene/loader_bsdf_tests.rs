@@ -4,6 +4,7 @@
 use super::tests::{m3, m3_err, shape_bsdf};
 use crate::bsdf::{
     BsdfKind, Conductor, Dielectric, Diffuse, Material, NoriMicrofacet, Plastic, RoughConductor,
+    RoughPlastic,
 };
 use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
 use glam::Vec3;
@@ -160,6 +161,22 @@ fn bsdf_parameters_and_defaults() {
         ),
         dielectric(2.419, 1.0)
     );
+    match b(
+        r#"<bsdf type="roughplastic"><string name="distribution" value="ggx"/>
+             <float name="alpha" value="0.3"/><boolean name="sample_visible" value="false"/>
+             <float name="int_ior" value="1.6"/><boolean name="nonlinear" value="true"/></bsdf>"#,
+    ) {
+        Material {
+            kind: BsdfKind::RoughPlastic(r),
+            ..
+        } => {
+            let mf = Microfacet::new(MicrofacetDistribution::Ggx, 0.3, 0.3);
+            let want =
+                RoughPlastic::new(mf, false, 1.6 / 1.000277, Vec3::splat(0.5), Vec3::ONE, true);
+            assert_eq!(r, want);
+        }
+        other => panic!("{other:?}"),
+    }
     let one_sided = |p: Plastic| one(BsdfKind::Plastic(p));
     assert_eq!(
         b(r#"<bsdf type="plastic"/>"#),
@@ -205,10 +222,10 @@ fn bsdf_parameters_and_defaults() {
             "{e}"
         );
     }
-    let e = m3_err(r#"<bsdf type="roughplastic" id="p"/>"#);
+    let e = m3_err(r#"<bsdf type="roughdielectric" id="p"/>"#);
     assert!(
         e.contains(
-            "test.xml:2: <bsdf type=\"roughplastic\" id=\"p\">: bsdf 'roughplastic' is not supported yet"
+            "test.xml:2: <bsdf type=\"roughdielectric\" id=\"p\">: bsdf 'roughdielectric' is not supported yet"
         ),
         "{e}"
     );
