@@ -264,6 +264,25 @@ pub fn microfacet<P: Params>(p: &mut P) -> Result<(Microfacet, bool), P::Error> 
     ))
 }
 
+/// The coating and base of Mitsuba's `plastic` and `roughplastic`: the index ratio
+/// int_ior / ext_ior (defaults "polypropylene", 1.49, and "air"), diffuse_reflectance (0.5),
+/// specular_reflectance (1) and nonlinear (false). Not both reflectances black (the lobe
+/// choice would divide 0 by 0).
+pub fn coated<P: Params>(p: &mut P) -> Result<(f32, Rgb, Rgb, bool), P::Error> {
+    let int_ior = ior(p, "int_ior", 1.49)?;
+    let ext_ior = ior(p, "ext_ior", DEFAULT_EXT_IOR)?;
+    let diffuse = reflectance(p, "diffuse_reflectance", Rgb::splat(0.5))?;
+    let specular = reflectance(p, "specular_reflectance", Rgb::ONE)?;
+    let nonlinear = p.boolean("nonlinear")?.unwrap_or(false);
+    if diffuse.max_element() + specular.max_element() <= 0.0 {
+        return Err(p.error(
+            None,
+            "diffuse_reflectance and specular_reflectance are both black".into(),
+        ));
+    }
+    Ok((int_ior / ext_ior, diffuse, specular, nonlinear))
+}
+
 /// No parameter given: a BSDF with its defaults (`BsdfKind::parse(ty, &mut Defaults)`).
 pub struct Defaults;
 

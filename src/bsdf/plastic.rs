@@ -84,18 +84,8 @@ impl Bsdf for Plastic {
     /// Mitsuba 3's names and defaults: int_ior "polypropylene" (1.49), ext_ior "air",
     /// diffuse_reflectance 0.5, specular_reflectance 1, nonlinear false.
     fn from_params<P: Params>(p: &mut P) -> Result<Self, P::Error> {
-        let int_ior = params::ior(p, "int_ior", 1.49)?;
-        let ext_ior = params::ior(p, "ext_ior", params::DEFAULT_EXT_IOR)?;
-        let diffuse = params::reflectance(p, "diffuse_reflectance", Rgb::splat(0.5))?;
-        let specular = params::reflectance(p, "specular_reflectance", Rgb::ONE)?;
-        let nonlinear = p.boolean("nonlinear")?.unwrap_or(false);
-        if diffuse.max_element() + specular.max_element() <= 0.0 {
-            return Err(p.error(
-                None,
-                "diffuse_reflectance and specular_reflectance are both black".into(),
-            ));
-        }
-        let m = Plastic::new(int_ior / ext_ior, diffuse, specular, nonlinear);
+        let (eta, diffuse, specular, nonlinear) = params::coated(p)?;
+        let m = Plastic::new(eta, diffuse, specular, nonlinear);
         let most = m.normal_albedo();
         if most > 1.01 {
             p.warn(format!(

@@ -148,14 +148,10 @@ impl Bsdf for RoughPlastic {
     /// Mitsuba 3's names and defaults: those of `plastic` and the microfacet lobe's
     /// `distribution` (beckmann), `alpha` (0.1) and `sample_visible` (true); isotropic only.
     fn from_params<P: Params>(p: &mut P) -> Result<Self, P::Error> {
-        let int_ior = params::ior(p, "int_ior", 1.49)?;
-        let ext_ior = params::ior(p, "ext_ior", params::DEFAULT_EXT_IOR)?;
-        if int_ior == ext_ior {
+        let (eta, diffuse, specular, nonlinear) = params::coated(p)?;
+        if eta == 1.0 {
             return Err(p.error(None, "int_ior and ext_ior must differ".into()));
         }
-        let diffuse = params::reflectance(p, "diffuse_reflectance", Rgb::splat(0.5))?;
-        let specular = params::reflectance(p, "specular_reflectance", Rgb::ONE)?;
-        let nonlinear = p.boolean("nonlinear")?.unwrap_or(false);
         let (mf, sample_visible) = params::microfacet(p)?;
         if mf.alpha_u != mf.alpha_v {
             return Err(p.error(
@@ -164,13 +160,6 @@ impl Bsdf for RoughPlastic {
                     .into(),
             ));
         }
-        if diffuse.max_element() + specular.max_element() <= 0.0 {
-            return Err(p.error(
-                None,
-                "diffuse_reflectance and specular_reflectance are both black".into(),
-            ));
-        }
-        let eta = int_ior / ext_ior;
         Ok(RoughPlastic::new(
             mf,
             sample_visible,
