@@ -311,6 +311,14 @@ pub(crate) mod tests {
                 "must differ",
             ),
             (
+                r#"<bsdf type="roughconductor"><string name="distribution" value="phong"/></bsdf>"#,
+                "\"phong\" is not supported yet",
+            ),
+            (
+                r#"<bsdf type="roughplastic"><string name="distribution" value="blinn"/></bsdf>"#,
+                "expected distribution \"beckmann\" or \"ggx\", found \"blinn\"",
+            ),
+            (
                 r#"<bsdf type="plastic"><float name="int_ior" value="0"/></bsdf>"#,
                 "int_ior must be positive",
             ),
