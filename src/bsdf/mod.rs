@@ -261,6 +261,15 @@ pub(crate) mod testing {
             return 0.0;
         }
         let pdf = m.pdf(wi, s.wo);
+        // eval_pdf is its own function (the estimator's): the same pair as eval and pdf.
+        let (f_joint, pdf_joint) = m.eval_pdf(wi, s.wo);
+        let f = m.eval(wi, s.wo);
+        assert!(
+            (pdf_joint - pdf).abs() <= 1e-6 * pdf
+                && (f_joint - f).abs().max_element() <= 1e-6 * f.max_element(),
+            "wi {wi} wo {}: eval_pdf ({f_joint}, {pdf_joint}) vs ({f}, {pdf})",
+            s.wo
+        );
         let e_pdf = (pdf - s.pdf).abs() / s.pdf;
         assert!(
             e_pdf <= 1e-3,

@@ -311,6 +311,14 @@ pub(crate) mod tests {
                 "must differ",
             ),
             (
+                r#"<bsdf type="roughconductor"><float name="alpha_u" value="0"/><float name="alpha_v" value="0.1"/></bsdf>"#,
+                "alpha) must be positive",
+            ),
+            (
+                r#"<bsdf type="roughconductor"><float name="alpha_u" value="0.1"/><float name="alpha_v" value="0"/></bsdf>"#,
+                "alpha) must be positive",
+            ),
+            (
                 r#"<bsdf type="roughconductor"><string name="distribution" value="phong"/></bsdf>"#,
                 "\"phong\" is not supported yet",
             ),
