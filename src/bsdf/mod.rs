@@ -306,6 +306,19 @@ pub(crate) mod testing {
         (Rgb::new(r as f32, g as f32, b as f32), p)
     }
 
+    /// The diffuse Fresnel reflectance F_dr(eta) = 2 int_0^1 F(mu, eta) mu dmu of the f32
+    /// Fresnel term, by Simpson's rule on 20k intervals in f64 (against which the fits of
+    /// `fresnel_diffuse_reflectance` are tested).
+    pub fn diffuse_fresnel_by_quadrature(eta: f32) -> f64 {
+        let n = 20_000;
+        let f = |mu: f64| super::fresnel::fresnel_dielectric(mu as f32, eta).0 as f64 * mu;
+        let h = 1.0 / n as f64;
+        let inner: f64 = (1..n)
+            .map(|i| f(i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 })
+            .sum();
+        2.0 * (f(0.0) + f(1.0) + inner) * h / 3.0
+    }
+
     /// Directional albedo by sampling: E[weight] for a fixed wi. Returns (mean, std error).
     pub fn albedo(m: &Material, wi: Vec3, n: usize) -> (Rgb, Rgb) {
         let mut rng = Rng::new(23, 5);

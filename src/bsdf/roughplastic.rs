@@ -37,7 +37,6 @@ pub struct RoughPlastic {
     pub nonlinear: bool,
     /// t(cos) at cos = i / 63.
     transmittance: Box<[f32; RES]>,
-    internal_reflectance: f32,
     /// d / (1 - R_int) / eta^2 / pi.
     diffuse_scale: Rgb,
     specular_weight: f32,
@@ -51,13 +50,18 @@ fn table_directions() -> impl Iterator<Item = (f32, Vec3)> {
     })
 }
 
-/// E over visible normals m of `f(m)`, by Gauss-Legendre on the unit square of the sampler's
-/// numbers: n x n nodes (32 for eta > 1, else 128, as Mitsuba).
-fn visible_mean(mf: &Microfacet, wi: Vec3, eta: f32, f: impl Fn(Vec3) -> f64) -> f64 {
-    let q = gauss_legendre(if eta > 1.0 { 32 } else { 128 });
+/// The Gauss-Legendre rule Mitsuba integrates these tables with at index ratio `eta`:
+/// 32 x 32 nodes above 1, 128 x 128 below.
+fn rule(eta: f32) -> Vec<(f64, f64)> {
+    gauss_legendre(if eta > 1.0 { 32 } else { 128 })
+}
+
+/// E over visible normals m of `f(m)`, by the rule `q` on the unit square of the sampler's
+/// numbers.
+fn visible_mean(mf: &Microfacet, wi: Vec3, q: &[(f64, f64)], f: impl Fn(Vec3) -> f64) -> f64 {
     let mut sum = 0.0;
-    for &(x, wx) in &q {
-        for &(y, wy) in &q {
+    for &(x, wx) in q {
+        for &(y, wy) in q {
             let u = Vec2::new((x * 0.5 + 0.5) as f32, (y * 0.5 + 0.5) as f32);
             sum += f(mf.sample_visible(wi, u)) * wx * wy * 0.25;
         }
@@ -76,8 +80,9 @@ impl RoughPlastic {
     ) -> Self {
         let mut transmittance = Box::new([0.0f32; RES]);
         let mut internal = 0.0f64;
+        let (outside, inside) = (rule(eta), rule(1.0 / eta));
         for (i, (mu, wi)) in table_directions().enumerate() {
-            transmittance[i] = visible_mean(&mf, wi, eta, |m| {
+            transmittance[i] = visible_mean(&mf, wi, &outside, |m| {
                 let (f, cos_t, eta_ti) = fresnel_dielectric(wi.dot(m), eta);
                 let wt = m * (wi.dot(m) * eta_ti + cos_t) - wi * eta_ti;
                 if wt.z * wi.z >= 0.0 {
@@ -85,7 +90,7 @@ impl RoughPlastic {
                 }
                 (mf.g1(wt, m) * (1.0 - f)) as f64
             }) as f32;
-            let r = visible_mean(&mf, wi, 1.0 / eta, |m| {
+            let r = visible_mean(&mf, wi, &inside, |m| {
                 let wo = 2.0 * wi.dot(m) * m - wi;
                 if wo.z <= 0.0 {
                     return 0.0;
@@ -113,7 +118,6 @@ impl RoughPlastic {
             diffuse_reflectance: diffuse,
             nonlinear,
             transmittance,
-            internal_reflectance,
             diffuse_scale: diffuse / divisor / (eta * eta) * INV_PI,
             specular_weight: s_mean / (d_mean + s_mean),
         }
@@ -126,10 +130,6 @@ impl RoughPlastic {
         let i = (x as usize).min(RES - 2);
         let w = x - i as f32;
         self.transmittance[i] * (1.0 - w) + self.transmittance[i + 1] * w
-    }
-
-    pub fn internal_reflectance(&self) -> f32 {
-        self.internal_reflectance
     }
 
     /// (t(cos_i), probability of the coating's lobe).

@@ -597,21 +597,14 @@ fn plastic_furnace_for_every_strategy() {
     use crate::math::Rgb;
     let (eta, d, s) = (1.5f32, 0.6f32, 0.9f32);
     let plastic = Plastic::new(eta, Rgb::splat(d), Rgb::splat(s), false);
-    let fdr = |e: f32| {
-        let n = 20_000;
-        let f = |mu: f64| fresnel_dielectric(mu as f32, e).0 as f64 * mu;
-        let h = 1.0 / n as f64;
-        let inner: f64 = (1..n)
-            .map(|i| f(i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 })
-            .sum();
-        2.0 * (f(0.0) + f(1.0) + inner) * h / 3.0
-    };
     let cos_i = 1.5 / 2.65f32.sqrt();
     let f_i = fresnel_dielectric(cos_i, eta).0 as f64;
     let fdr_int = crate::bsdf::fresnel::fresnel_diffuse_reflectance(1.0 / eta) as f64;
     let eta2 = (eta * eta) as f64;
-    let expected =
-        1.0 + s as f64 * f_i + (1.0 - f_i) * d as f64 / (eta2 * (1.0 - fdr_int)) * (1.0 - fdr(eta));
+    let expected = 1.0
+        + s as f64 * f_i
+        + (1.0 - f_i) * d as f64 / (eta2 * (1.0 - fdr_int))
+            * (1.0 - crate::bsdf::testing::diffuse_fresnel_by_quadrature(eta));
     let strategies = all_strategies();
     let zc = z_critical(ALPHA, strategies.len() * 2);
     for split in [false, true] {
