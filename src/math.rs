@@ -1,5 +1,6 @@
 //! Small geometric helpers shared by every module.
 
+use crate::rng::LANES;
 use glam::{Vec3, Vec3A};
 
 /// Linear RGB triple used for colours, radiance and intensities.
@@ -20,6 +21,52 @@ pub struct Frame {
     pub s: Vec3,
     pub t: Vec3,
     pub n: Vec3,
+}
+
+/// Eight 3-vectors, one array per component: the lane kernel's and the BSDFs' lane code
+/// loop over them, which the compiler turns into vector code. 32-byte aligned, for the
+/// reason `geometry::PacketHits` gives.
+#[derive(Clone, Copy, Default)]
+#[repr(C, align(32))]
+pub struct V3x8 {
+    pub x: [f32; LANES],
+    pub y: [f32; LANES],
+    pub z: [f32; LANES],
+}
+
+impl V3x8 {
+    #[inline(always)]
+    pub fn splat(v: Vec3) -> Self {
+        V3x8 {
+            x: [v.x; LANES],
+            y: [v.y; LANES],
+            z: [v.z; LANES],
+        }
+    }
+
+    #[inline(always)]
+    pub fn get(&self, i: usize) -> Vec3 {
+        Vec3::new(self.x[i], self.y[i], self.z[i])
+    }
+
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, v: Vec3) {
+        (self.x[i], self.y[i], self.z[i]) = (v.x, v.y, v.z);
+    }
+
+    /// The components as a ray packet holds them.
+    #[inline(always)]
+    pub fn axes(&self) -> [[f32; LANES]; 3] {
+        [self.x, self.y, self.z]
+    }
+
+    /// Copies the components from a ray packet's layout, axis by axis: built as a whole
+    /// value, the copy went through a stack temporary whose 32-byte stores were read back
+    /// as 64-byte loads, which cannot be forwarded from them (a stall of each copy).
+    #[inline(always)]
+    pub fn copy_axes(&mut self, [x, y, z]: &[[f32; LANES]; 3]) {
+        (self.x, self.y, self.z) = (*x, *y, *z);
+    }
 }
 
 /// `v / s`, all three quotients in one SIMD division (each correctly rounded, so bitwise the

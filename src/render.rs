@@ -2,7 +2,7 @@
 //! so the image is bitwise identical for any thread count.
 
 use crate::film::Image;
-use crate::integrator::{Direct, LaneScratch, Strategy};
+use crate::integrator::{LaneKernel, LaneScratch, Strategy};
 use crate::rng::LANES;
 use crate::sampler::{IndependentLanes, SamplerLanes};
 use crate::scene::Scene;
@@ -169,13 +169,13 @@ fn is_finite(v: glam::Vec3) -> bool {
 /// One pixel's samples, drawn by the sampler `L` (the render's only one so far is
 /// `independent`).
 fn render_pixel<L: SamplerLanes>(
-    direct: &Direct,
+    kernel: &LaneKernel,
     x: u32,
     y: u32,
     settings: &RenderSettings,
     scratch: &mut LaneScratch,
 ) -> PixelResult {
-    let cam = &direct.scene.camera;
+    let cam = &kernel.direct.scene.camera;
     let pixel = y as u64 * cam.width as u64 + x as u64;
     let mut stats = PixelStats::default();
     let mut non_finite = 0;
@@ -188,7 +188,7 @@ fn render_pixel<L: SamplerLanes>(
         let mut lanes = L::start(key, settings.first_sample + s0 as u64);
         let rays = cam.generate_rays(x, y, &mut lanes);
         let n = (settings.spp - s0).min(LANES as u32) as usize;
-        let values = direct.li_lanes(&rays, n, &mut lanes, scratch);
+        let values = kernel.li_lanes(&rays, n, &mut lanes, scratch);
         // Counted and reported; a correct estimator has none (tests assert 0).
         non_finite += stats.push_batch(&values, n);
     }
@@ -205,20 +205,20 @@ fn render_pixel<L: SamplerLanes>(
 /// (`bench::raylimit::measure_interleaved`). Returns the sum of their red means, so that no
 /// pixel's work can be dropped.
 pub fn render_rows(
-    direct: &Direct,
+    kernel: &LaneKernel,
     rows: std::ops::Range<u32>,
     settings: &RenderSettings,
     scratch: &mut LaneScratch,
 ) -> f64 {
-    let w = direct.scene.camera.width;
+    let w = kernel.direct.scene.camera.width;
     rows.flat_map(|y| (0..w).map(move |x| (x, y)))
-        .map(|(x, y)| render_pixel::<IndependentLanes>(direct, x, y, settings, scratch).mean[0])
+        .map(|(x, y)| render_pixel::<IndependentLanes>(kernel, x, y, settings, scratch).mean[0])
         .sum()
 }
 
 pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> RenderOutput {
     let (w, h) = (scene.camera.width, scene.camera.height);
-    let direct = Direct::new(scene, strategy);
+    let kernel = LaneKernel::new(scene, strategy);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
@@ -254,7 +254,7 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
                 for y in y0..(y0 + TILE).min(h) {
                     for x in x0..(x0 + TILE).min(w) {
                         let r =
-                            render_pixel::<IndependentLanes>(&direct, x, y, settings, &mut scratch);
+                            render_pixel::<IndependentLanes>(&kernel, x, y, settings, &mut scratch);
                         out.push((x, y, r));
                     }
                 }
@@ -405,10 +405,10 @@ mod tests {
             progress: false,
         };
         let out = render(&scene, strategy, &settings);
-        let direct = Direct::new(&scene, strategy);
+        let kernel = LaneKernel::new(&scene, strategy);
         let mut scratch = LaneScratch::default();
         for rows in [0..3, 3..4, 4..7] {
-            let band = render_rows(&direct, rows.clone(), &settings, &mut scratch);
+            let band = render_rows(&kernel, rows.clone(), &settings, &mut scratch);
             let want: f64 = rows
                 .flat_map(|y| (0..10).map(move |x| (x, y)))
                 .map(|(x, y)| out.mean.get(x, y)[0])

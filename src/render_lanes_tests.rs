@@ -16,7 +16,7 @@ fn per_sample_mismatch(
     settings: &RenderSettings,
 ) -> Result<u32, String> {
     let out = render(scene, strategy, settings);
-    let direct = Direct::new(scene, strategy);
+    let direct = crate::integrator::Direct::new(scene, strategy);
     let cam = &scene.camera;
     let mut lit = 0;
     for y in 0..cam.height {
@@ -50,7 +50,7 @@ fn per_sample_mismatch(
     Ok(lit)
 }
 
-/// The render loop starts samples eight at a time and, where `Direct::li_lanes` covers
+/// The render loop starts samples eight at a time and, where `LaneKernel::li_lanes` covers
 /// the scene, shades them eight at a time; every pixel must still be exactly the
 /// per-sample definition: generator `for_sample(seed, pixel, s)`, `generate_ray`, `li`.
 /// spp 11 leaves a partial batch of three. Each case states whether the lanes cover it,
@@ -160,8 +160,8 @@ fn lane_samples_are_bitwise_the_per_sample_definition() {
             threads: Some(1),
             progress: false,
         };
-        let direct = Direct::new(&scene, strategy);
-        assert_eq!(direct.has_lanes(), lanes, "{rel}: lane coverage");
+        let kernel = LaneKernel::new(&scene, strategy);
+        assert_eq!(kernel.has_lanes(), lanes, "{rel}: lane coverage");
         let lit = per_sample_mismatch(&scene, strategy, &settings)
             .unwrap_or_else(|e| panic!("{rel}: {e}"));
         let cam = &scene.camera;
@@ -218,9 +218,9 @@ fn random_scenes_render_bitwise_as_their_per_sample_definition() {
             false => all[(pick.next_u32() as usize) % all.len()],
         };
         let scene = Scene::build(r.desc).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
-        let direct = Direct::new(&scene, strategy);
+        let kernel = LaneKernel::new(&scene, strategy);
         let want = covered.contains(&strategy) && r.features.point_lights == 0;
-        assert_eq!(direct.has_lanes(), want, "seed {seed}: lane coverage");
+        assert_eq!(kernel.has_lanes(), want, "seed {seed}: lane coverage");
         let settings = RenderSettings {
             spp: 11,
             seed: seed ^ 0xabc,
@@ -279,8 +279,13 @@ fn random_scenes_render_bitwise_as_their_per_sample_definition() {
         "diffuse",
         "rough-beckmann-grey",
         "rough-ggx",
+        "rough-coloured",
         "twosided",
+        "twosided-rough",
         "dielectric",
+        "plastic",
+        "roughplastic",
+        "nori-microfacet",
     ] {
         want.push(format!("material {m}"));
     }

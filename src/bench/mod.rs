@@ -225,11 +225,11 @@ fn ray_limit_section(
         limit.outside_seconds_per_sample * 1e9,
     );
     // The same with tracing and rendering paired band by band.
-    let direct = crate::integrator::Direct::new(scene, mis);
+    let kernel = crate::integrator::LaneKernel::new(scene, mis);
     let banded = |threads| {
         let spps = (mix_spp, a.spp);
         let (share, outside) =
-            raylimit::measure_interleaved(&direct, &mix, spps, threads, a.repeat);
+            raylimit::measure_interleaved(&kernel, &mix, spps, threads, a.repeat);
         println!(
             "  traced and rendered band by band ({} rows each) on {threads} thread(s): {:.0}% of render time outside traversal, {:.1} ns of thread time per sample",
             raylimit::BAND_ROWS,

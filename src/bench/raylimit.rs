@@ -409,14 +409,14 @@ pub const BAND_ROWS: u32 = 8;
 /// over `repeat` passes of (share, seconds of thread time per sample outside traversal).
 /// `mix_spp` must be the mix's.
 pub fn measure_interleaved(
-    direct: &crate::integrator::Direct,
+    kernel: &crate::integrator::LaneKernel,
     mix: &RayMix,
     (mix_spp, spp): (u32, u32),
     threads: usize,
     repeat: u32,
 ) -> (f64, f64) {
     use crate::render::{render_rows, RenderSettings};
-    let (scene, threads) = (direct.scene, threads.max(1));
+    let (scene, threads) = (kernel.direct.scene, threads.max(1));
     let (w, h) = (scene.camera.width, scene.camera.height);
     let per_row = w as usize * (mix_spp as usize).div_ceil(LANES);
     assert_eq!(
@@ -448,7 +448,7 @@ pub fn measure_interleaved(
                     (sink, traced) = (sink + s as f64, traced + seconds);
                 } else {
                     let t = Instant::now();
-                    sink += render_rows(direct, rows.clone(), &settings, &mut scratch);
+                    sink += render_rows(kernel, rows.clone(), &settings, &mut scratch);
                     rendered += t.elapsed().as_secs_f64();
                 }
             }

@@ -69,7 +69,7 @@ fn banded_share_over_a_short_last_band() {
     (d.film.width, d.film.height) = (6, BAND_ROWS + 3);
     let scene = Scene::build(d).expect("fixture scene");
     let mis = crate::bench::power_mis();
-    let direct = crate::integrator::Direct::new(&scene, mis);
+    let direct = crate::integrator::LaneKernel::new(&scene, mis);
     let mix = ray_mix(&scene, 8, mis.selection);
     for threads in [1, 2] {
         let (share, outside) = measure_interleaved(&direct, &mix, (8, 24), threads, 1);

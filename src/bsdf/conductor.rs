@@ -10,7 +10,7 @@ use crate::math::Rgb;
 use glam::Vec2;
 use glam::Vec3;
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Conductor {
     pub eta: Rgb,
     pub k: Rgb,
@@ -44,6 +44,7 @@ impl Bsdf for Conductor {
             specular_reflectance,
         })
     }
+    #[inline]
     fn sample(&self, wi: Vec3, _: f32, _: Vec2) -> Option<BsdfSample> {
         Conductor::sample(self, wi)
     }

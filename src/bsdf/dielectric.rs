@@ -16,7 +16,7 @@ use crate::math::Rgb;
 use glam::Vec2;
 use glam::Vec3;
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Dielectric {
     /// int_ior / ext_ior.
     pub eta: f32,
@@ -64,6 +64,7 @@ impl Bsdf for Dielectric {
             eta: int_ior / ext_ior,
         })
     }
+    #[inline]
     fn sample(&self, wi: Vec3, u1: f32, _: Vec2) -> Option<BsdfSample> {
         Dielectric::sample(self, wi, u1)
     }

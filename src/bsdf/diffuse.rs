@@ -7,7 +7,7 @@ use crate::math::{Rgb, INV_PI};
 use crate::sampling::warps::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use glam::{Vec2, Vec3};
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Diffuse {
     pub reflectance: Rgb,
 }
@@ -68,12 +68,15 @@ impl Bsdf for Diffuse {
         };
         Ok(Diffuse { reflectance })
     }
+    #[inline]
     fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
         Diffuse::eval(self, wi, wo)
     }
+    #[inline]
     fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
         Diffuse::pdf(self, wi, wo)
     }
+    #[inline]
     fn sample(&self, wi: Vec3, _: f32, u2: Vec2) -> Option<BsdfSample> {
         Diffuse::sample(self, wi, u2)
     }

@@ -7,7 +7,7 @@ use crate::math::Rgb;
 use glam::Vec2;
 use glam::Vec3;
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Mirror;
 
 /// Mirror direction about the local normal.
@@ -38,6 +38,7 @@ impl Bsdf for Mirror {
     fn from_params<P: Params>(_: &mut P) -> Result<Self, P::Error> {
         Ok(Mirror)
     }
+    #[inline]
     fn sample(&self, wi: Vec3, _: f32, _: Vec2) -> Option<BsdfSample> {
         Mirror::sample(self, wi)
     }

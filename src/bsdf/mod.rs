@@ -13,6 +13,7 @@ mod nori_microfacet;
 pub mod params;
 mod plastic;
 mod roughconductor;
+mod roughconductor_lanes;
 mod roughplastic;
 
 pub use conductor::Conductor;
@@ -24,9 +25,37 @@ pub use plastic::Plastic;
 pub use roughconductor::RoughConductor;
 pub use roughplastic::RoughPlastic;
 
-use crate::math::Rgb;
+use crate::math::{Rgb, V3x8};
+use crate::rng::LANES;
 use glam::{Vec2, Vec3};
 use params::Params;
+
+/// Eight lanes' `BsdfSample`s, one array per field (`Bsdf::sample_lanes`): an array of
+/// `Option<BsdfSample>` kept the loops that write and read it from running in vector lanes.
+#[derive(Default)]
+#[repr(C, align(32))]
+pub struct BsdfSamples {
+    pub wo: V3x8,
+    pub weight: V3x8,
+    pub pdf: [f32; LANES],
+    /// Whether the lane has a sample (the rest of a lane without one is unspecified).
+    pub ok: [bool; LANES],
+    pub delta: [bool; LANES],
+}
+
+impl BsdfSamples {
+    /// Stores lane i's sample, if `live`.
+    #[inline(always)]
+    pub fn set(&mut self, i: usize, s: Option<BsdfSample>, live: bool) {
+        let (ok, wo, weight, pdf, delta) = match s {
+            Some(s) => (live, s.wo, s.weight, s.pdf, s.delta),
+            None => (false, Vec3::Z, Rgb::ZERO, 0.0, false),
+        };
+        (self.ok[i], self.pdf[i], self.delta[i]) = (ok, pdf, delta);
+        self.wo.set(i, wo);
+        self.weight.set(i, weight);
+    }
+}
 
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample {
@@ -40,7 +69,9 @@ pub struct BsdfSample {
 
 /// A material model, one file each; `registry!` below lists them. In the local shading frame
 /// (z = shading normal), one-sided: `Material` mirrors the configuration for two-sided use.
-pub trait Bsdf: Sized {
+/// Plain data (`Copy`): the lane kernel copies a batch's BSDFs next to its working arrays,
+/// where the compiler can see that no store of the kernel's changes them.
+pub trait Bsdf: Sized + Copy {
     /// Every lobe is a Dirac delta: `eval` and `pdf` are 0, `sample` gives the lobes.
     const DELTA: bool;
     /// Some lobe is a Dirac delta (every lobe for a `DELTA` BSDF; the coating of `plastic`).
@@ -66,6 +97,78 @@ pub trait Bsdf: Sized {
     }
     /// A direction with weight eval / pdf: `u1` picks a lobe, `u2` the direction within it.
     fn sample(&self, wi: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample>;
+
+    // How the lane kernel (`integrator::lanes`) evaluates and samples eight hits at once.
+    // The defaults call the methods above lane by lane, so every BSDF with a density runs
+    // in lanes as it is; a BSDF overrides them only to share work between the light and the
+    // BSDF sample of a hit, or to sample in vector lanes. Each override must give bitwise
+    // what the methods above give (the lane tests compare every sample with `li`'s).
+
+    /// Whether the lane kernel shades this BSDF (every one with a density, by default); a
+    /// BSDF whose lane methods cover only some of its parameters says which, and the rest
+    /// shade lane by lane with `Direct::li_hit`.
+    fn lane_covered(&self) -> bool {
+        !Self::DELTA
+    }
+    /// A value the hit's two samples share, computed once per hit from wi (the rough
+    /// conductor's Smith Lambda(wi)); 0 by default.
+    #[inline(always)]
+    fn lane_shared(&self, _wi: Vec3) -> f32 {
+        0.0
+    }
+    /// `eval_pdf` given `lane_shared(wi)`.
+    #[inline(always)]
+    fn eval_pdf_shared(&self, wi: Vec3, wo: Vec3, _shared: f32) -> (Rgb, f32) {
+        self.eval_pdf(wi, wo)
+    }
+    /// `sample` of every lane in `live`, lane i with its BSDF `b(i)`, wi, `lane_shared` and
+    /// the numbers `u` (lobe, then the direction's two); lanes outside `live` hold garbage
+    /// and get none.
+    #[inline(always)]
+    fn sample_lanes<'b>(
+        b: impl Fn(usize) -> &'b Self + Copy,
+        wi: &V3x8,
+        _shared: &[f32; LANES],
+        u: &[[f32; LANES]; 3],
+        live: u32,
+    ) -> BsdfSamples
+    where
+        Self: 'b,
+    {
+        sample_each(b, wi, u, live)
+    }
+}
+
+/// `Bsdf::sample_lanes` lane by lane: `sample` of each lane in `live`.
+#[inline(always)]
+pub(crate) fn sample_each<'b, B: Bsdf + 'b>(
+    b: impl Fn(usize) -> &'b B,
+    wi: &V3x8,
+    u: &[[f32; LANES]; 3],
+    live: u32,
+) -> BsdfSamples {
+    // Every lane is sampled, garbage included, and then masked: a branch around the call
+    // kept the loop from running in vector lanes.
+    let mut out = BsdfSamples::default();
+    let [u_lobe, u_x, u_y] = u;
+    for i in 0..LANES {
+        let s = b(i).sample(wi.get(i), u_lobe[i], Vec2::new(u_x[i], u_y[i]));
+        out.set(i, s, live >> i & 1 != 0);
+    }
+    out
+}
+
+/// A generic operation on the BSDF a `BsdfKind` holds (`BsdfKind::visit`): how the lane
+/// kernel gets from the closed set to code compiled for one BSDF type.
+pub trait BsdfVisitor {
+    type Out;
+    fn visit<B: Bsdf + Registered>(self, b: &B) -> Self::Out;
+}
+
+/// A registered BSDF type: which `BsdfKind` variant holds it.
+pub trait Registered: Sized {
+    /// The BSDF `kind` holds, if it is of this type.
+    fn view(kind: &BsdfKind) -> Option<&Self>;
 }
 
 /// The registration: one line per BSDF, `Variant(Type) = "scene type name"`. It makes the
@@ -73,14 +176,28 @@ pub trait Bsdf: Sized {
 /// dispatch, the parser's table and `REGISTERED`, the list every per-BSDF test loops over.
 macro_rules! registry {
     ($($variant:ident($ty:ty) = $name:literal;)*) => {
-        /// Closed set of materials, one variant per registered BSDF.
+        /// Closed set of materials, one variant per registered BSDF. Plain data, as large
+        /// as its largest variant (rough plastic's table): a scene holds one per material
+        /// and the estimator reads them in place.
         #[derive(Clone, Debug, PartialEq)]
+        #[allow(clippy::large_enum_variant)]
         pub enum BsdfKind {
             $($variant($ty),)*
         }
 
         /// The scene type names of the registered BSDFs.
         pub const REGISTERED: &[&str] = &[$($name,)*];
+
+        $(impl Registered for $ty {
+            #[inline(always)]
+            fn view(kind: &BsdfKind) -> Option<&Self> {
+                match kind {
+                    BsdfKind::$variant(b) => Some(b),
+                    #[allow(unreachable_patterns)]
+                    _ => None,
+                }
+            }
+        })*
 
         impl BsdfKind {
             /// The BSDF of scene type `ty` from its parameters; None for a type not registered.
@@ -97,10 +214,37 @@ macro_rules! registry {
                 }
             }
 
+            /// `Bsdf::lane_covered` of the BSDF it holds.
+            pub fn lane_covered(&self) -> bool {
+                match self {
+                    $(BsdfKind::$variant(b) => Bsdf::lane_covered(b),)*
+                }
+            }
+
             pub fn has_delta_lobe(&self) -> bool {
                 match self {
                     $(BsdfKind::$variant(_) => <$ty as Bsdf>::DELTA_LOBE,)*
                 }
+            }
+
+            /// `v.visit` of the BSDF it holds.
+            #[inline(always)]
+            pub fn visit<V: BsdfVisitor>(&self, v: V) -> V::Out {
+                match self {
+                    $(BsdfKind::$variant(b) => v.visit(b),)*
+                }
+            }
+
+            /// Its position in the registration: equal for two materials of the same type.
+            pub fn index(&self) -> usize {
+                let mut i = 0usize;
+                $(
+                    if let BsdfKind::$variant(_) = self {
+                        return i;
+                    }
+                    i += 1;
+                )*
+                unreachable!("{i} registered BSDFs")
             }
 
             /// Its scene type name.
@@ -170,10 +314,25 @@ impl Material {
     /// Two-sided materials mirror the configuration into the upper hemisphere.
     #[inline]
     fn orient(&self, wi: Vec3, wo: Vec3) -> (Vec3, Vec3) {
-        if self.two_sided && wi.z < 0.0 {
-            (Vec3::new(wi.x, wi.y, -wi.z), Vec3::new(wo.x, wo.y, -wo.z))
+        let (wi, flip) = Self::side(self.two_sided, wi);
+        (wi, Self::mirror(flip, wo))
+    }
+
+    /// wi as a material of this sidedness hands it to its BSDF (mirrored into the upper
+    /// hemisphere for a two-sided one seen from below), and whether it was mirrored.
+    #[inline(always)]
+    pub(crate) fn side(two_sided: bool, wi: Vec3) -> (Vec3, bool) {
+        let flip = two_sided && wi.z < 0.0;
+        (Self::mirror(flip, wi), flip)
+    }
+
+    /// v mirrored in the surface if `flip`.
+    #[inline(always)]
+    pub(crate) fn mirror(flip: bool, v: Vec3) -> Vec3 {
+        if flip {
+            Vec3::new(v.x, v.y, -v.z)
         } else {
-            (wi, wo)
+            v
         }
     }
 
@@ -209,16 +368,9 @@ impl Material {
     /// `u1` picks a lobe, `u2` the direction within it: separate numbers for separate decisions.
     #[inline]
     pub fn sample(&self, wi: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
-        let flip = self.two_sided && wi.z < 0.0;
-        let wi_up = if flip {
-            Vec3::new(wi.x, wi.y, -wi.z)
-        } else {
-            wi
-        };
+        let (wi_up, flip) = Self::side(self.two_sided, wi);
         let mut s = self.kind.sample(wi_up, u1, u2)?;
-        if flip {
-            s.wo.z = -s.wo.z;
-        }
+        s.wo = Self::mirror(flip, s.wo);
         Some(s)
     }
 }

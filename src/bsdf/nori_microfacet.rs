@@ -16,7 +16,7 @@ use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
 use crate::sampling::warps::square_to_cosine_hemisphere;
 use glam::{Vec2, Vec3};
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NoriMicrofacet {
     mf: Microfacet,
     alpha: f32,
@@ -125,12 +125,15 @@ impl Bsdf for NoriMicrofacet {
         }
         Ok(NoriMicrofacet::new(alpha, int_ior, ext_ior, kd))
     }
+    #[inline]
     fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
         NoriMicrofacet::eval(self, wi, wo)
     }
+    #[inline]
     fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
         NoriMicrofacet::pdf(self, wi, wo)
     }
+    #[inline]
     fn sample(&self, wi: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
         NoriMicrofacet::sample(self, wi, u1, u2)
     }

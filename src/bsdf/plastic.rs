@@ -17,7 +17,7 @@ use crate::math::{Rgb, INV_PI};
 use crate::sampling::warps::{square_to_cosine_hemisphere, square_to_cosine_hemisphere_pdf};
 use glam::{Vec2, Vec3};
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Plastic {
     /// int_ior / ext_ior.
     pub eta: f32,
@@ -98,10 +98,12 @@ impl Bsdf for Plastic {
         Ok(m)
     }
 
+    #[inline]
     fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
         self.eval_pdf(wi, wo).0
     }
 
+    #[inline]
     fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
         self.eval_pdf(wi, wo).1
     }

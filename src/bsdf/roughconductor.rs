@@ -11,15 +11,16 @@
 //! (chi-square, pdf mass) check that this pdf is the sampler's true density.
 //! One-sided: black for wi.z <= 0.
 
-use super::fresnel::fresnel_conductor;
+use super::fresnel::{fresnel_conductor, fresnel_conductor_channel, is_grey};
 use super::params::{self, Params};
 use super::Bsdf;
-use super::BsdfSample;
-use crate::math::Rgb;
+use super::{BsdfSample, BsdfSamples};
+use crate::math::{Rgb, V3x8};
+use crate::rng::LANES;
 use crate::sampling::microfacet::Microfacet;
 use glam::{DVec3, Vec2, Vec3};
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoughConductor {
     pub mf: Microfacet,
     pub sample_visible: bool,
@@ -32,6 +33,12 @@ impl RoughConductor {
     #[inline]
     fn fresnel(&self, cos: f32) -> Rgb {
         fresnel_conductor(cos, self.eta, self.k) * self.specular_reflectance
+    }
+
+    /// `fresnel` of a grey index (`lane_covered`), without its test for one.
+    #[inline(always)]
+    pub(super) fn fresnel_grey(&self, cos: f32) -> Rgb {
+        Rgb::splat(fresnel_conductor_channel(cos, self.eta.x, self.k.x)) * self.specular_reflectance
     }
 
     /// Half vector of unit wi and wo, summed in f64: wi + wo nearly cancels at grazing
@@ -165,17 +172,50 @@ impl Bsdf for RoughConductor {
             specular_reflectance,
         })
     }
+    #[inline]
     fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
         RoughConductor::eval(self, wi, wo)
     }
+    #[inline]
     fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
         RoughConductor::pdf(self, wi, wo)
     }
+    #[inline]
     fn eval_pdf(&self, wi: Vec3, wo: Vec3) -> (Rgb, f32) {
         RoughConductor::eval_pdf(self, wi, wo)
     }
+    #[inline]
     fn sample(&self, wi: Vec3, _: f32, u2: Vec2) -> Option<BsdfSample> {
         RoughConductor::sample(self, wi, u2)
+    }
+    /// Grey indices only (Mitsuba's default among them): their Fresnel term is one channel,
+    /// which the lanes' loops inline (`fresnel_grey`); the three-channel form is a call per
+    /// lane, which kept the loops from running in vector lanes.
+    fn lane_covered(&self) -> bool {
+        is_grey(self.eta, self.k)
+    }
+    /// Smith's Lambda(wi), once for both samples of a hit.
+    #[inline(always)]
+    fn lane_shared(&self, wi: Vec3) -> f32 {
+        self.mf.lambda(wi)
+    }
+    /// `eval_pdf` without its early return, which `eval_pdf_with` ends in as a select.
+    #[inline(always)]
+    fn eval_pdf_shared(&self, wi: Vec3, wo: Vec3, lambda_i: f32) -> (Rgb, f32) {
+        self.eval_pdf_with(wi, wo, lambda_i, |c| self.fresnel_grey(c))
+    }
+    #[inline(always)]
+    fn sample_lanes<'b>(
+        b: impl Fn(usize) -> &'b Self + Copy,
+        wi: &V3x8,
+        lambda_i: &[f32; LANES],
+        u: &[[f32; LANES]; 3],
+        live: u32,
+    ) -> BsdfSamples
+    where
+        Self: 'b,
+    {
+        super::roughconductor_lanes::sample_lanes(b, wi, lambda_i, u, live)
     }
 }
 

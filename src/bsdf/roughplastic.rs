@@ -26,7 +26,7 @@ use glam::{Vec2, Vec3};
 /// Cosines of the transmittance table (Mitsuba's MI_ROUGH_TRANSMITTANCE_RES).
 const RES: usize = 64;
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoughPlastic {
     /// The coating's lobe: its microfacets and sampler (its conductor indices are unused;
     /// the dielectric Fresnel term is handed in).
@@ -36,7 +36,7 @@ pub struct RoughPlastic {
     pub diffuse_reflectance: Rgb,
     pub nonlinear: bool,
     /// t(cos) at cos = i / 63.
-    transmittance: Box<[f32; RES]>,
+    transmittance: [f32; RES],
     /// d / (1 - R_int) / eta^2 / pi.
     diffuse_scale: Rgb,
     specular_weight: f32,
@@ -78,7 +78,7 @@ impl RoughPlastic {
         specular: Rgb,
         nonlinear: bool,
     ) -> Self {
-        let mut transmittance = Box::new([0.0f32; RES]);
+        let mut transmittance = [0.0f32; RES];
         let mut internal = 0.0f64;
         let (outside, inside) = (rule(eta), rule(1.0 / eta));
         for (i, (mu, wi)) in table_directions().enumerate() {
@@ -170,10 +170,12 @@ impl Bsdf for RoughPlastic {
         ))
     }
 
+    #[inline]
     fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
         self.eval_pdf(wi, wo).0
     }
 
+    #[inline]
     fn pdf(&self, wi: Vec3, wo: Vec3) -> f32 {
         self.eval_pdf(wi, wo).1
     }

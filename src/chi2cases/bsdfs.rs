@@ -75,12 +75,7 @@ pub fn materials() -> Vec<Entry> {
         reflectance: Rgb::new(0.2, 0.5, 0.9),
     };
     let mut v = vec![
-        entry(
-            "diffuse".into(),
-            BsdfKind::Diffuse(diffuse.clone()),
-            false,
-            None,
-        ),
+        entry("diffuse".into(), BsdfKind::Diffuse(diffuse), false, None),
         entry(
             "diffuse-twosided".into(),
             BsdfKind::Diffuse(diffuse),

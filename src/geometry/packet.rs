@@ -347,8 +347,21 @@ impl Accel {
             },
             |c| self.prefetch(c),
         );
-        // Hits on meshes without vertex normals (flat shading) gather their triangle here and
-        // get their points in lanes below; others get `surface_point`'s, one by one.
+        self.fill_hits(rays, active, shapes, (&best, &tmax), out);
+    }
+
+    /// `intersect8_into` after traversal: each ray's best primitive and its distance into
+    /// `out`. Hits on meshes without vertex normals (flat shading) gather their triangle here
+    /// and get their points in lanes below; others get `surface_point`'s, one by one.
+    #[inline(always)]
+    fn fill_hits(
+        &self,
+        rays: &RayPacket,
+        active: u32,
+        shapes: &[Shape],
+        (best, tmax): (&[(u32, Vec2); PACKET], &[f32; PACKET]),
+        out: &mut PacketHits,
+    ) {
         let (mut flat, mut v) = (0u32, [[[0.0; PACKET]; 3]; 3]);
         let (mut b1, mut b2) = ([0.0; PACKET], [0.0; PACKET]);
         for i in bits(active) {

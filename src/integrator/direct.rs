@@ -9,7 +9,6 @@
 //! delta lights: light sampling only) are handled by that technique with weight 1 in every
 //! strategy, including the pure ones, so no strategy loses them and none counts them twice.
 
-use super::lane_tables::{lane_setup, Lanes};
 use super::Strategy;
 use crate::bsdf::{BsdfSample, Material};
 use crate::emitter::{EmitterSelector, LightSample};
@@ -25,8 +24,6 @@ pub struct Direct<'a> {
     pub strategy: Strategy,
     pub(super) selector: EmitterSelector,
     has_delta_lights: bool,
-    /// Set when `li_lanes` covers the scene and strategy.
-    pub(super) lanes: Option<Lanes<'a>>,
 }
 
 #[inline]
@@ -57,7 +54,6 @@ impl<'a> Direct<'a> {
             scene,
             strategy,
             has_delta_lights: scene.emitters.iter().any(|e| e.is_delta()),
-            lanes: lane_setup(scene, &strategy, &selector),
             selector,
         }
     }

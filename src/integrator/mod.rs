@@ -1,14 +1,13 @@
-//! Direct-illumination estimators: light sampling, BSDF sampling and their MIS combinations.
+//! Direct-illumination estimators: light sampling, BSDF sampling and their MIS combinations
+//! (`Direct`, one camera ray at a time), and the lane kernel that runs the same estimator on
+//! eight camera samples at once (`LaneKernel`).
 
 mod direct;
-mod lane_tables;
 mod lanes;
-mod lanes_light;
-mod lanes_rough;
 mod strategy;
 
 pub use direct::Direct;
-pub use lanes::LaneScratch;
+pub use lanes::{LaneKernel, LaneScratch};
 pub use strategy::{Strategy, StrategyOverrides};
 
 #[cfg(test)]

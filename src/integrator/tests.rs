@@ -611,7 +611,7 @@ fn plastic_furnace_for_every_strategy() {
         let mut desc = fixtures::furnace(0.5, split, 1);
         desc.camera.fov_degrees = 1e-3;
         for shape in &mut desc.shapes {
-            shape.bsdf = fixtures::one_sided(BsdfKind::Plastic(plastic.clone()));
+            shape.bsdf = fixtures::one_sided(BsdfKind::Plastic(plastic));
         }
         let scene = Scene::build(desc).unwrap();
         for st in &strategies {

@@ -11,7 +11,8 @@ use super::desc::*;
 use super::fixtures::{diffuse, sphere, tri_mesh};
 use super::mesh::{cube, load_obj, TriMesh};
 use crate::bsdf::{
-    BsdfKind, Conductor, Dielectric, Diffuse, Material, Mirror, NoriMicrofacet, RoughConductor,
+    BsdfKind, Conductor, Dielectric, Diffuse, Material, Mirror, NoriMicrofacet, Plastic,
+    RoughConductor, RoughPlastic,
 };
 use crate::math::look_at;
 use crate::rng::Rng;
@@ -91,7 +92,7 @@ impl Gen {
                 specular_reflectance: g.rgb(0.3, 1.0),
             })
         };
-        let (kind, name) = match self.below(20) {
+        let (kind, name) = match self.below(24) {
             0..=6 => (
                 BsdfKind::Diffuse(Diffuse {
                     reflectance: self.rgb(0.0, 0.95),
@@ -134,6 +135,41 @@ impl Gen {
                 "dielectric",
             ),
             17 => (BsdfKind::Mirror(Mirror), "mirror"),
+            18 => (
+                BsdfKind::Plastic(Plastic::new(
+                    self.f(1.2, 2.0),
+                    self.rgb(0.0, 0.9),
+                    self.rgb(0.5, 1.0),
+                    self.chance(0.5),
+                )),
+                "plastic",
+            ),
+            19 => {
+                let distribution = match self.chance(0.5) {
+                    true => MicrofacetDistribution::Beckmann,
+                    false => MicrofacetDistribution::Ggx,
+                };
+                let alpha = self.f(0.05, 0.6);
+                let kind = BsdfKind::RoughPlastic(RoughPlastic::new(
+                    Microfacet::new(distribution, alpha, alpha),
+                    self.chance(0.85),
+                    self.f(1.2, 2.0),
+                    self.rgb(0.0, 0.9),
+                    self.rgb(0.5, 1.0),
+                    self.chance(0.5),
+                ));
+                (kind, "roughplastic")
+            }
+            20 => {
+                let kind = rough(self, MicrofacetDistribution::Beckmann, true);
+                return (
+                    Material {
+                        kind,
+                        two_sided: true,
+                    },
+                    "twosided-rough",
+                );
+            }
             _ => (
                 BsdfKind::NoriMicrofacet(NoriMicrofacet::new(
                     self.f(0.05, 0.6),

@@ -1,16 +1,14 @@
 //! The lane kernel's light draws: emitter and triangle choice for eight samples (the table
-//! lookups of `light_draw`), and each lane's point on the drawn triangle or sphere
-//! (`light_sample`). The tables they read are built once per render in `lane_tables`.
+//! lookups of `Direct::light_draw`), and each lane's point on the drawn triangle or sphere
+//! (`light_sample`). The tables they read are built once per render in `tables`.
 
 #![allow(clippy::needless_range_loop)]
 
-use super::direct::Direct;
-use super::lane_tables::{LaneLight, LaneLightKind, LightTriangle, SmallLights, SmallMesh};
-use super::lanes::V3x8;
-use crate::emitter::{area_pdf_along, sample_at, sphere_area_point};
+use super::tables::{LaneLight, LaneLightKind, LightTriangle, SmallLights, SmallMesh};
+use crate::emitter::{area_pdf_along, sample_at, sphere_area_point, EmitterSelector};
 use crate::geometry::ray_packet::bits;
 use crate::geometry::{lookup8, Mesh, Sphere, SurfacePoint};
-use crate::math::Rgb;
+use crate::math::{Rgb, V3x8};
 use crate::rng::LANES;
 use crate::sampling::warps::square_to_uniform_triangle;
 use crate::sampling::AliasTable;
@@ -64,7 +62,7 @@ impl LightDraws {
         self.tri[i] = tri as u32;
     }
 
-    /// `light_draws`'s emitter choice and copies for two to eight emitters, for all lanes at
+    /// `draw`'s emitter choice and copies for two to eight emitters, for all lanes at
     /// once from register-held tables (`SmallLights`); lanes whose light is a mesh then draw
     /// their triangles one by one.
     #[inline(always)]
@@ -137,11 +135,12 @@ impl LightDraws {
     }
 }
 
-impl Direct<'_> {
-    /// Emitter and triangle choice and the triangle's data: the table lookups of `light_draw`.
+impl LightDraws {
+    /// Emitter and triangle choice with `selector` and the triangle's data: the table lookups
+    /// of `Direct::light_draw`.
     #[inline(always)]
-    pub(super) fn light_draws(
-        &self,
+    pub(super) fn draw(
+        selector: &EmitterSelector,
         lights: &[LaneLight],
         small: Option<&SmallLights>,
         u_emitter: &[f32; LANES],
@@ -151,7 +150,7 @@ impl Direct<'_> {
     ) {
         // The one field a lane's triangle leaves unwritten (a mesh without vertex normals).
         d.has_normals = [false; LANES];
-        if let Some(pmf) = self.selector.single() {
+        if let Some(pmf) = selector.single() {
             // Every lane draws the one emitter: its data is copied once.
             let light = &lights[0];
             d.shape = [light.shape; LANES];
@@ -180,7 +179,7 @@ impl Direct<'_> {
             return d.small_lights(t, lights, u_emitter, u_tri, spheres);
         }
         for i in 0..LANES {
-            let Some((e, pmf)) = self.selector.sample(u_emitter[i]) else {
+            let Some((e, pmf)) = selector.sample(u_emitter[i]) else {
                 continue;
             };
             let light = &lights[e];
@@ -321,7 +320,7 @@ mod tests {
         }
     }
 
-    /// `small_lights` draws, for every lane, bitwise what `light_draws`' per-lane loop draws
+    /// `small_lights` draws, for every lane, bitwise what `draw`'s per-lane loop draws
     /// with the same numbers: sphere lights (the Veach scene), mesh lights (two quads), and
     /// both in one scene, by uniform and by power choice; random numbers and the edges.
     #[test]
@@ -349,8 +348,9 @@ mod tests {
                             && s.light_sampling == crate::emitter::LightSampling::Area
                     })
                     .unwrap();
-                let direct = Direct::new(&scene, strategy);
-                let lanes = direct.lanes.as_ref().expect("covered");
+                let kernel = super::super::LaneKernel::new(&scene, strategy);
+                let lanes = kernel.tables.as_ref().expect("covered");
+                let selector = &kernel.direct.selector;
                 let small = lanes.small_lights.as_deref().expect("two to eight lights");
                 let n = scene.emitters.len() as f32;
                 let edges: [f32; LANES] = std::array::from_fn(|k| match k {
@@ -366,8 +366,9 @@ mod tests {
                 for (u_e, u_t) in batches {
                     let (mut a, mut b) = (LightDraws::default(), LightDraws::default());
                     let (mut sa, mut sb) = (SphereDraws::default(), SphereDraws::default());
-                    direct.light_draws(&lanes.lights, None, &u_e, &u_t, &mut a, &mut sa);
-                    direct.light_draws(&lanes.lights, Some(small), &u_e, &u_t, &mut b, &mut sb);
+                    let lights = &lanes.lights;
+                    LightDraws::draw(selector, lights, None, &u_e, &u_t, &mut a, &mut sa);
+                    LightDraws::draw(selector, lights, Some(small), &u_e, &u_t, &mut b, &mut sb);
                     assert_eq!(a.shape, b.shape, "u {u_e:?}");
                     assert_eq!(a.pmf.map(f32::to_bits), b.pmf.map(f32::to_bits));
                     assert_eq!(a.area.map(f32::to_bits), b.area.map(f32::to_bits));

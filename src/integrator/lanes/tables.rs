@@ -1,16 +1,13 @@
-//! The tables the lane kernel (`lanes`) reads, built once per render: the lights it can sample
+//! The tables the lane kernel reads, built once per render: the lights it can sample
 //! (one 64-byte record per light triangle) and one row per shape (its material as the lanes
 //! shade it, its emitter and its skip-id bases), so that a lane's lookups touch one table each
 //! where the scene keeps the same data in several.
 
-use super::Strategy;
-use crate::bsdf::fresnel::is_grey;
-use crate::bsdf::{BsdfKind, RoughConductor};
 use crate::emitter::{AreaLight, Emitter, EmitterSelector, LightSampling};
 use crate::geometry::{lookup8, Mesh, ShapeKind, Sphere, NO_SKIP};
+use crate::integrator::Strategy;
 use crate::rng::LANES;
 use crate::sampling::elementary::small_int_bits;
-use crate::sampling::microfacet::MicrofacetDistribution;
 use crate::sampling::AliasTable;
 use crate::scene::desc::StrategyKind;
 use crate::scene::Scene;
@@ -153,33 +150,32 @@ impl SmallMesh {
     }
 }
 
-/// How the lanes shade a hit's material.
+/// A material the lanes shade (`Bsdf::lane_covered`: any whose BSDF has a density, but for
+/// a rough conductor's coloured index), with its batch key: the
+/// lanes of one batch share a BSDF type and sidedness, so that one instance of the shading
+/// code runs them.
 #[derive(Clone, Copy)]
-pub(super) enum LaneMaterial {
-    /// One-sided diffuse, with its reflectance.
-    Diffuse(Vec3),
-    /// A rough conductor `lanes_rough` covers: specular reflectance, roughness, grey index.
-    Rough {
-        reflectance: Vec3,
-        alpha: (f32, f32),
-        eta_k: (f32, f32),
-    },
-    /// Left to the scalar path.
-    Other,
+pub(super) struct LaneMaterial {
+    /// Its index in `Scene::materials`.
+    pub(super) index: u32,
+    /// The BSDF type's registration index and the sidedness.
+    pub(super) key: u32,
+    pub(super) two_sided: bool,
 }
 
 /// What `camera_hits` needs of a hit's shape, in one lookup where `Scene::material`,
 /// `Scene::emitter_at` and the two `skip_id`s read five tables.
 #[derive(Clone, Copy)]
 pub(super) struct LaneShape {
-    pub(super) material: LaneMaterial,
+    /// None for a material left to the scalar path.
+    pub(super) material: Option<LaneMaterial>,
     pub(super) emitter: Option<u32>,
     pub(super) skip_base: u32,
     pub(super) emitter_skip_base: u32,
 }
 
 /// The tables of the lanes: one light per emitter, one record per shape.
-pub(super) struct Lanes<'a> {
+pub(super) struct LaneTables<'a> {
     pub(super) lights: Vec<LaneLight<'a>>,
     pub(super) shapes: Vec<LaneShape>,
     /// The emitter choice in lane form, for two to eight emitters.
@@ -233,29 +229,30 @@ impl SmallLights {
     }
 }
 
+/// The light and BSDF sample counts of the only strategies the lanes cover
+/// (`lane_setup`). As constants, `Direct::li`'s divisions by them and multiplications compile
+/// to nothing, which dividing by a 1 read from the strategy did not. x / 1 and 1 * x are x
+/// exactly, so every sample is still bitwise `li`'s.
+pub(super) const SAMPLE_COUNTS: (u32, u32) = (1, 1);
+
 /// The lanes' tables if the scene and strategy are the configuration the lanes cover;
 /// otherwise None and `Direct` shades every sample with `li`.
 pub(super) fn lane_setup<'a>(
     scene: &'a Scene,
     s: &Strategy,
     selector: &EmitterSelector,
-) -> Option<Lanes<'a>> {
+) -> Option<LaneTables<'a>> {
     let lights = lane_lights(scene, s)?;
     let small_lights = SmallLights::new(&lights, selector).map(Box::new);
     let shapes = (0u32..)
         .zip(&scene.shapes)
         .map(|(shape, sh)| {
             let mat = &scene.materials[sh.material as usize];
-            let material = match &mat.kind {
-                _ if mat.two_sided => LaneMaterial::Other,
-                BsdfKind::Diffuse(diffuse) => LaneMaterial::Diffuse(diffuse.reflectance),
-                BsdfKind::RoughConductor(rc) if rough_covered(rc) => LaneMaterial::Rough {
-                    reflectance: rc.specular_reflectance,
-                    alpha: (rc.mf.alpha_u, rc.mf.alpha_v),
-                    eta_k: (rc.eta.x, rc.k.x),
-                },
-                _ => LaneMaterial::Other,
-            };
+            let material = mat.kind.lane_covered().then(|| LaneMaterial {
+                index: sh.material,
+                key: 2 * mat.kind.index() as u32 + mat.two_sided as u32,
+                two_sided: mat.two_sided,
+            });
             LaneShape {
                 material,
                 emitter: sh.emitter,
@@ -267,7 +264,7 @@ pub(super) fn lane_setup<'a>(
             }
         })
         .collect();
-    Some(Lanes {
+    Some(LaneTables {
         lights,
         shapes,
         small_lights,
@@ -278,7 +275,7 @@ pub(super) fn lane_setup<'a>(
 /// lanes cover.
 fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>> {
     let covered = s.kind == StrategyKind::Mis
-        && (s.emitter_samples, s.bsdf_samples) == super::lanes::SAMPLE_COUNTS
+        && (s.emitter_samples, s.bsdf_samples) == SAMPLE_COUNTS
         && s.light_sampling == LightSampling::Area
         && !scene.emitters.is_empty();
     if !covered {
@@ -311,14 +308,6 @@ fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>>
             Emitter::Point(_) => None,
         })
         .collect()
-}
-
-/// Rough conductors the lanes shade (`lanes_rough`): Beckmann with visible-normal sampling
-/// and a grey index (one Fresnel channel), the Veach scene's plates.
-pub(super) fn rough_covered(rc: &RoughConductor) -> bool {
-    rc.mf.distribution == MicrofacetDistribution::Beckmann
-        && rc.sample_visible
-        && is_grey(rc.eta, rc.k)
 }
 
 #[cfg(test)]
@@ -354,28 +343,34 @@ mod tests {
             )
             .expect("covered");
             assert_eq!(lanes.shapes.len(), scene.shapes.len());
-            let mut kinds = [0; 3];
+            // Rows by (lanes shade it, two-sided).
+            let mut kinds = [[0; 2]; 2];
             for (i, (row, shape)) in lanes.shapes.iter().zip(&scene.shapes).enumerate() {
                 let mat = &scene.materials[shape.material as usize];
-                let k = match (&row.material, &mat.kind) {
-                    (LaneMaterial::Diffuse(r), BsdfKind::Diffuse(d)) => {
-                        assert!(!mat.two_sided && *r == d.reflectance, "{rel} shape {i}");
-                        0
+                match row.material {
+                    Some(m) => {
+                        assert!(
+                            !mat.is_delta() && mat.kind.lane_covered(),
+                            "{rel} shape {i}"
+                        );
+                        assert_eq!(m.index, shape.material, "{rel} shape {i}");
+                        assert_eq!(m.two_sided, mat.two_sided, "{rel} shape {i}");
+                        kinds[0][mat.two_sided as usize] += 1;
                     }
-                    (LaneMaterial::Rough { reflectance, .. }, BsdfKind::RoughConductor(rc)) => {
-                        assert!(!mat.two_sided && rough_covered(rc), "{rel} shape {i}");
-                        assert_eq!(*reflectance, rc.specular_reflectance);
-                        1
+                    None => {
+                        assert!(!mat.kind.lane_covered(), "{rel} shape {i}");
+                        kinds[1][mat.two_sided as usize] += 1;
                     }
-                    (LaneMaterial::Other, kind) => {
-                        let covered = matches!(kind, BsdfKind::Diffuse(_))
-                            || matches!(kind, BsdfKind::RoughConductor(rc) if rough_covered(rc));
-                        assert!(mat.two_sided || !covered, "{rel} shape {i}");
-                        2
+                }
+                // One key per BSDF type and sidedness.
+                for (other, o) in lanes.shapes.iter().zip(&scene.shapes) {
+                    let om = &scene.materials[o.material as usize];
+                    if let (Some(a), Some(b)) = (row.material, other.material) {
+                        let same = mat.kind.type_name() == om.kind.type_name()
+                            && mat.two_sided == om.two_sided;
+                        assert_eq!(a.key == b.key, same, "{rel} shape {i}");
                     }
-                    _ => panic!("{rel} shape {i}: row and material of different kinds"),
-                };
-                kinds[k] += 1;
+                }
                 assert_eq!(row.emitter, shape.emitter);
                 let prims = match &shape.kind {
                     ShapeKind::Mesh(m) => m.indices.len() as u32,
@@ -401,11 +396,9 @@ mod tests {
                     );
                 }
             }
-            assert!(kinds[0] > 0, "{rel}: {kinds:?}");
+            assert!(kinds[0][0] > 0, "{rel}: {kinds:?}");
             if rel.starts_with("cbox") {
-                assert!(kinds[2] > 0, "{rel}: uncovered materials {kinds:?}");
-            } else {
-                assert!(kinds[1] > 0, "{rel}: rough plates {kinds:?}");
+                assert!(kinds[1][0] > 0, "{rel}: delta materials {kinds:?}");
             }
         }
     }
