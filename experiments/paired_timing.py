@@ -27,6 +27,7 @@ import tempfile
 SCENES = {
     "cbox": ["scenes/cbox/cbox.xml", "--spp", "64"],
     "veach": ["scenes/veach-mis/veach-mis.xml", "--spp", "32"],
+    "plastic": ["scenes/cbox-plastic/cbox-plastic.xml", "-D", "res=256", "--spp", "64"],
 }
 STRATEGY = ["--strategy", "mis", "--heuristic", "power", "--emitter-selection", "power"]
 

@@ -68,3 +68,10 @@ fn all_strategies_agree_on_the_cornell_box() {
 fn all_strategies_agree_on_the_materials_box() {
     check_scene("scenes/cbox-materials/cbox-materials.xml", 256);
 }
+
+/// Plastic, rough plastic (GGX and Beckmann), Nori's microfacet and a two-sided wall, all
+/// shaded in lanes under MIS and on the scalar path under the other strategies.
+#[test]
+fn all_strategies_agree_on_the_plastic_box() {
+    check_scene("scenes/cbox-plastic/cbox-plastic.xml", 256);
+}

@@ -11,4 +11,6 @@ pub use lanes::{LaneKernel, LaneScratch};
 pub use strategy::{Strategy, StrategyOverrides};
 
 #[cfg(test)]
+mod coated_tests;
+#[cfg(test)]
 pub(crate) mod tests;

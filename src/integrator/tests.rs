@@ -42,7 +42,7 @@ pub(crate) fn image_z(out: &RenderOutput, expected: f64) -> (f64, f64) {
     ((mean - expected) / var.sqrt(), mean)
 }
 
-fn settings(spp: u32, seed: u64) -> RenderSettings {
+pub(crate) fn settings(spp: u32, seed: u64) -> RenderSettings {
     RenderSettings {
         spp,
         seed,
@@ -582,47 +582,4 @@ fn estimator_draws_the_documented_dimension_groups() {
         one_sample_picks.0 > 0 && one_sample_picks.1 > 0,
         "{one_sample_picks:?}"
     );
-}
-
-/// Plastic (a delta coating over a diffuse base) in the white furnace, seen at one point
-/// (one pixel, fov 1e-3 degrees, cos_i = 1.5 / sqrt(2.65) on the far face): every strategy
-/// must give 1 + s F(cos_i) + (1 - F(cos_i)) d / (eta^2 (1 - F_dr,int)) (1 - F_dr,ext),
-/// with F_dr,ext by quadrature. Light sampling reaches the coating's reflection only through
-/// its BSDF samples for the delta lobe; without them it misses s F(cos_i) = 0.047.
-/// z-tests at ALPHA, Sidak over strategies and both emitter layouts.
-#[test]
-fn plastic_furnace_for_every_strategy() {
-    use crate::bsdf::fresnel::fresnel_dielectric;
-    use crate::bsdf::{BsdfKind, Plastic};
-    use crate::math::Rgb;
-    let (eta, d, s) = (1.5f32, 0.6f32, 0.9f32);
-    let plastic = Plastic::new(eta, Rgb::splat(d), Rgb::splat(s), false);
-    let cos_i = 1.5 / 2.65f32.sqrt();
-    let f_i = fresnel_dielectric(cos_i, eta).0 as f64;
-    let fdr_int = crate::bsdf::fresnel::fresnel_diffuse_reflectance(1.0 / eta) as f64;
-    let eta2 = (eta * eta) as f64;
-    let expected = 1.0
-        + s as f64 * f_i
-        + (1.0 - f_i) * d as f64 / (eta2 * (1.0 - fdr_int))
-            * (1.0 - crate::bsdf::testing::diffuse_fresnel_by_quadrature(eta));
-    let strategies = all_strategies();
-    let zc = z_critical(ALPHA, strategies.len() * 2);
-    for split in [false, true] {
-        let mut desc = fixtures::furnace(0.5, split, 1);
-        desc.camera.fov_degrees = 1e-3;
-        for shape in &mut desc.shapes {
-            shape.bsdf = fixtures::one_sided(BsdfKind::Plastic(plastic));
-        }
-        let scene = Scene::build(desc).unwrap();
-        for st in &strategies {
-            let out = render(&scene, *st, &settings(40_000, 3));
-            assert_eq!(out.non_finite_samples, 0);
-            let (z, mean) = image_z(&out, expected);
-            assert!(
-                z.abs() < zc,
-                "{} split={split}: mean {mean} vs {expected}, z = {z:.2} (critical {zc:.2})",
-                st.label()
-            );
-        }
-    }
 }

@@ -111,6 +111,14 @@ fn cases(ty: &str) -> Vec<Case> {
             ),
         ],
         "mirror" => vec![case(r#"<bsdf type="mirror"/>"#, true, None)],
+        "roughplastic" | "plastic" | "microfacet" => coated_cases(ty),
+        _ => vec![],
+    }
+}
+
+/// `cases` of the BSDFs with a diffuse base under a coating.
+fn coated_cases(ty: &str) -> Vec<Case> {
+    match ty {
         // Not lossless even when white: the diffuse Fresnel fits leave white plastic 0.1 %
         // above or below 1 (the BSDF's own tests bound it).
         "roughplastic" => {

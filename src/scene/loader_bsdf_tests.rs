@@ -85,12 +85,14 @@ fn refs_and_twosided() {
     assert!(e.contains("refers to itself"), "{e}");
 }
 
+/// The material of a rectangle holding `inner`.
+fn b(inner: &str) -> Material {
+    let s = m3(&format!(r#"<shape type="rectangle">{inner}</shape>"#));
+    shape_bsdf(&s).clone()
+}
+
 #[test]
 fn bsdf_parameters_and_defaults() {
-    let b = |inner: &str| {
-        let s = m3(&format!(r#"<shape type="rectangle">{inner}</shape>"#));
-        shape_bsdf(&s).clone()
-    };
     assert_eq!(b(r#"<bsdf type="diffuse"/>"#), diffuse(Vec3::splat(0.5)));
     assert_eq!(
         b(r#"<bsdf type="diffuse"><float name="reflectance" value="0.2"/></bsdf>"#),
@@ -161,6 +163,10 @@ fn bsdf_parameters_and_defaults() {
         ),
         dielectric(2.419, 1.0)
     );
+}
+
+#[test]
+fn coated_bsdf_parameters_and_defaults() {
     match b(
         r#"<bsdf type="roughplastic"><string name="distribution" value="ggx"/>
              <float name="alpha" value="0.3"/><boolean name="sample_visible" value="false"/>
@@ -200,7 +206,10 @@ fn bsdf_parameters_and_defaults() {
             true
         ))
     );
+}
 
+#[test]
+fn bsdf_parameter_errors() {
     let e =
         m3_err(r#"<bsdf type="dielectric" id="g"><string name="int_ior" value="glassy"/></bsdf>"#);
     assert!(e.contains("unknown IOR name \"glassy\""), "{e}");

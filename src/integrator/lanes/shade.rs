@@ -49,7 +49,7 @@ impl LaneKernel<'_> {
 
     /// `shade_batch`, out of line (see `li_lanes`).
     #[inline(never)]
-    #[allow(clippy::too_many_arguments)]
+    #[allow(clippy::too_many_arguments)] // see `shade_batch`
     pub(super) fn shade_batch_out_of_line<B: Bsdf + Registered, const SPHERES: bool>(
         &self,
         h: &CameraHits,
@@ -63,8 +63,8 @@ impl LaneKernel<'_> {
     }
 
     /// `shade_batch` for a batch of several materials (at a pixel straddling two), out of
-    /// line: one function holding both instances of `shade` compiled neither into vector
-    /// code.
+    /// line, so that the instance for one material, which nearly every batch takes,
+    /// compiles as it would alone.
     #[inline(never)]
     #[allow(clippy::too_many_arguments)] // see `shade_batch`
     fn shade_mixed<B: Bsdf + Registered, const SPHERES: bool>(
