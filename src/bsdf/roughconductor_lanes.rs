@@ -164,6 +164,74 @@ mod tests {
     use crate::sampling::microfacet::ITERS;
     use glam::Vec3;
 
+    /// `Bsdf::sample_lanes` of the rough conductor is `sample` lane by lane, bitwise, for
+    /// the lanes in `live`, and gives nothing for the others: grey Beckmann with visible
+    /// normals (the vector path) and the per-lane fallback (GGX, all-normal sampling), wi
+    /// above, on and below the horizon, every live mask of a set.
+    #[test]
+    fn lane_samples_are_the_scalar_samples_of_live_lanes() {
+        use crate::bsdf::{Bsdf, RoughConductor};
+        use crate::math::Rgb;
+        use crate::rng::Rng;
+        use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
+        use crate::sampling::warps::square_to_uniform_sphere;
+        use glam::Vec2;
+        let mut rng = Rng::new(8, 3);
+        let mut seen = [0u32; 3];
+        for (dist, visible) in [
+            (MicrofacetDistribution::Beckmann, true),
+            (MicrofacetDistribution::Ggx, true),
+            (MicrofacetDistribution::Beckmann, false),
+        ] {
+            let rc = RoughConductor {
+                mf: Microfacet::new(dist, 0.3, 0.15),
+                sample_visible: visible,
+                eta: Rgb::splat(0.2),
+                k: Rgb::splat(3.0),
+                specular_reflectance: Rgb::new(0.9, 0.8, 0.7),
+            };
+            for batch in 0..200 {
+                let mut wi = V3x8::default();
+                let mut u = [[0.0f32; LANES]; 3];
+                let mut lambda = [0.0f32; LANES];
+                for i in 0..LANES {
+                    let mut w = square_to_uniform_sphere(rng.next_2d());
+                    if i == 7 {
+                        w = Vec3::new(w.x, w.y, 0.0).normalize();
+                    }
+                    wi.set(i, w);
+                    lambda[i] = rc.lane_shared(w);
+                    u.iter_mut().for_each(|u| u[i] = rng.next_f32());
+                }
+                let live = [0xff, 0x5a, 0x81][batch % 3];
+                let got = RoughConductor::sample_lanes(|_| &rc, &wi, &lambda, &u, live);
+                for i in 0..LANES {
+                    let want = Bsdf::sample(&rc, wi.get(i), u[0][i], Vec2::new(u[1][i], u[2][i]));
+                    match (live >> i & 1 != 0, want) {
+                        (true, Some(w)) => {
+                            assert!(got.ok[i], "lane {i} wi {}", wi.get(i));
+                            let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                            assert_eq!(bits(got.wo.get(i)), bits(w.wo));
+                            assert_eq!(bits(got.weight.get(i)), bits(w.weight));
+                            assert_eq!(got.pdf[i].to_bits(), w.pdf.to_bits());
+                            assert!(!got.delta[i]);
+                            seen[0] += 1;
+                        }
+                        (true, None) => {
+                            assert!(!got.ok[i], "lane {i} wi {}: a sample", wi.get(i));
+                            seen[1] += 1;
+                        }
+                        (false, _) => {
+                            assert!(!got.ok[i], "lane {i} outside live {live:#x}");
+                            seen[2] += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 100), "{seen:?}");
+    }
+
     /// The lanes' inversion is the scalar sampler's, bitwise, also for lanes that need
     /// scalar steps after the vector ones (grazing incidence with u near 0, found by counting
     /// the scalar steps), and whichever lanes are live.
