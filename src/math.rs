@@ -55,7 +55,7 @@ impl V3x8 {
     }
 
     /// The components as a ray packet holds them.
-    #[inline(always)]
+    #[cfg(test)]
     pub fn axes(&self) -> [[f32; LANES]; 3] {
         [self.x, self.y, self.z]
     }
