@@ -151,6 +151,13 @@ pub struct RenderArgs {
     /// Worker threads (default: all cores). The image does not depend on it.
     #[arg(long, value_parser = crate::render::parse_threads)]
     pub threads: Option<usize>,
+    /// Sampler (default: the scene's <sampler type>, mapped to the nearest directlab one).
+    #[arg(long, value_enum)]
+    pub sampler: Option<crate::sampler::SamplerKind>,
+    /// Dimension allocation: a light or BSDF sample's numbers as one joint point, or padded
+    /// 1D/2D draws (only the Sobol' samplers draw jointly).
+    #[arg(long, value_enum, default_value_t)]
+    pub dims: crate::sampler::DimAlloc,
     /// Output EXR (default: <scene name>.exr in the current directory); a PNG preview is
     /// written beside it.
     #[arg(long)]
@@ -184,6 +191,8 @@ struct RenderStats {
     strategy: String,
     spp: u32,
     seed: u64,
+    sampler: &'static str,
+    dims: &'static str,
     threads: usize,
     width: u32,
     height: u32,
@@ -243,7 +252,14 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
         first_sample: 0,
         threads: a.threads,
         progress: std::io::stderr().is_terminal(),
+        sampling: crate::sampler::Sampling {
+            kind: a.sampler.unwrap_or(scene.desc.sampler.kind),
+            dims: a.dims,
+            run_samples: None,
+        },
     };
+    let width = scene.camera.width;
+    settings.sampler_config(width)?;
     let result = render(&scene, strategy, &settings);
     film::write_exr(&out, &result.mean)?;
     film::write_png(&out.with_extension("png"), &result.mean)?;
@@ -255,6 +271,8 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
         strategy: strategy.label(),
         spp: settings.spp,
         seed: settings.seed,
+        sampler: settings.sampling.kind.name(),
+        dims: settings.sampling.dims.name(),
         threads: settings.threads.unwrap_or_else(rayon::current_num_threads),
         width: result.mean.width,
         height: result.mean.height,

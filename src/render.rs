@@ -4,7 +4,7 @@
 use crate::film::Image;
 use crate::integrator::{LaneKernel, LaneScratch, Strategy};
 use crate::rng::LANES;
-use crate::sampler::{IndependentLanes, SamplerLanes};
+use crate::sampler::{LanesVisitor, SamplerConfig, SamplerLanes, Sampling};
 use crate::scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -39,6 +39,16 @@ pub struct RenderSettings {
     /// Worker threads; None uses rayon's default (all cores).
     pub threads: Option<usize>,
     pub progress: bool,
+    /// The sampler and its dimension allocation.
+    pub sampling: Sampling,
+}
+
+impl RenderSettings {
+    /// The sampler's configuration for this render, or why it cannot draw its samples.
+    pub fn sampler_config(&self, width: u32) -> Result<SamplerConfig, String> {
+        self.sampling
+            .config(self.seed, self.first_sample, self.spp, width)
+    }
 }
 
 /// Per-pixel sample mean and the variance of that mean (sample variance / spp), both f64.
@@ -166,20 +176,62 @@ fn is_finite(v: glam::Vec3) -> bool {
     (v.x - v.x) + (v.y - v.y) + (v.z - v.z) == 0.0
 }
 
-/// One pixel's samples, drawn by the sampler `L` (the render's only one so far is
-/// `independent`).
+/// One pixel of a render, for the sampler of its settings.
+struct Pixel<'a> {
+    kernel: &'a LaneKernel<'a>,
+    x: u32,
+    y: u32,
+    settings: &'a RenderSettings,
+    cfg: &'a SamplerConfig,
+    scratch: &'a mut LaneScratch,
+}
+
+impl LanesVisitor for Pixel<'_> {
+    type Output = PixelResult;
+    #[inline(always)]
+    fn visit<L: SamplerLanes>(self) -> PixelResult {
+        render_pixel::<L>(
+            self.kernel,
+            self.x,
+            self.y,
+            self.settings,
+            self.cfg,
+            self.scratch,
+        )
+    }
+}
+
+fn render_any_pixel(
+    kernel: &LaneKernel,
+    x: u32,
+    y: u32,
+    settings: &RenderSettings,
+    cfg: &SamplerConfig,
+    scratch: &mut LaneScratch,
+) -> PixelResult {
+    settings.sampling.kind.visit(Pixel {
+        kernel,
+        x,
+        y,
+        settings,
+        cfg,
+        scratch,
+    })
+}
+
+/// One pixel's samples, drawn by the sampler `L`.
 fn render_pixel<L: SamplerLanes>(
     kernel: &LaneKernel,
     x: u32,
     y: u32,
     settings: &RenderSettings,
+    cfg: &SamplerConfig,
     scratch: &mut LaneScratch,
 ) -> PixelResult {
-    let cam = &kernel.direct.scene.camera;
-    let pixel = y as u64 * cam.width as u64 + x as u64;
     let mut stats = PixelStats::default();
     let mut non_finite = 0;
-    let key = L::pixel(settings.seed, pixel);
+    let cam = &kernel.direct.scene.camera;
+    let key = L::pixel(cfg, x, y);
     // Samples go LANES at a time: their generators and camera rays are computed side by side
     // in vector registers, and `li_lanes` shades them together where it covers the scene;
     // each sample stays bitwise what `for_pixel_sample`, `generate_ray` and `li` give it
@@ -211,14 +263,20 @@ pub fn render_rows(
     scratch: &mut LaneScratch,
 ) -> f64 {
     let w = kernel.direct.scene.camera.width;
+    let cfg = settings
+        .sampler_config(w)
+        .expect("sampler settings checked by the caller");
     rows.flat_map(|y| (0..w).map(move |x| (x, y)))
-        .map(|(x, y)| render_pixel::<IndependentLanes>(kernel, x, y, settings, scratch).mean[0])
+        .map(|(x, y)| render_any_pixel(kernel, x, y, settings, &cfg, scratch).mean[0])
         .sum()
 }
 
 pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> RenderOutput {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let kernel = LaneKernel::new(scene, strategy);
+    let cfg = settings
+        .sampler_config(w)
+        .expect("sampler settings checked by the caller");
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
@@ -253,8 +311,7 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
                 let mut scratch = LaneScratch::default();
                 for y in y0..(y0 + TILE).min(h) {
                     for x in x0..(x0 + TILE).min(w) {
-                        let r =
-                            render_pixel::<IndependentLanes>(&kernel, x, y, settings, &mut scratch);
+                        let r = render_any_pixel(&kernel, x, y, settings, &cfg, &mut scratch);
                         out.push((x, y, r));
                     }
                 }
@@ -403,6 +460,7 @@ mod tests {
             first_sample: 0,
             threads: Some(2),
             progress: false,
+            sampling: Default::default(),
         };
         let out = render(&scene, strategy, &settings);
         let kernel = LaneKernel::new(&scene, strategy);

@@ -1,5 +1,6 @@
 //! Images are pinned bit for bit: every bundled scene under every strategy of
-//! `Strategy::combinations`, at 1 and 2 threads, hashes to the checksum stored in
+//! `Strategy::combinations` (and every other sampler and dimension allocation under one
+//! strategy), at 1 and 2 threads, hashes to the checksum stored in
 //! `tests/data/image_checksums.txt`. A change that moves any image's bits (a refactor of the
 //! estimators, the lane kernel or the samplers that was meant to keep them) fails here and
 //! names the renders it changed. A change meant to alter images regenerates the file with
@@ -7,6 +8,7 @@
 
 use crate::integrator::Strategy;
 use crate::render::{render, RenderSettings};
+use crate::sampler::{DimAlloc, SamplerKind, Sampling};
 use crate::scene::{bundled_tests, Scene};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -49,7 +51,21 @@ fn bundled_images_keep_their_bits_for_every_strategy_and_thread_count() {
             hide_emitters: true,
             ..all[1]
         });
-        for s in all {
+        // Every strategy with `independent`, and every other sampler and allocation with
+        // one strategy.
+        let mut runs: Vec<(Strategy, Sampling)> =
+            all.iter().map(|&s| (s, Sampling::default())).collect();
+        for kind in &SamplerKind::ALL[1..] {
+            for dims in [DimAlloc::Joint, DimAlloc::Padded] {
+                let sampling = Sampling {
+                    kind: *kind,
+                    dims,
+                    run_samples: None,
+                };
+                runs.push((all[1], sampling));
+            }
+        }
+        for (s, sampling) in runs {
             let sums = [1, 2].map(|threads| {
                 let settings = RenderSettings {
                     spp: 11,
@@ -57,18 +73,19 @@ fn bundled_images_keep_their_bits_for_every_strategy_and_thread_count() {
                     first_sample: 0,
                     threads: Some(threads),
                     progress: false,
+                    sampling,
                 };
                 hash(&render(&scene, s, &settings))
             });
-            assert_eq!(
-                sums[0],
-                sums[1],
-                "{rel} {}: 1 and 2 threads differ",
-                s.label()
-            );
             let hidden = if s.hide_emitters { "-hidden" } else { "" };
+            let sampler = match sampling.kind {
+                SamplerKind::Independent => String::new(),
+                k => format!(" {} {}", k.name(), sampling.dims.name()),
+            };
+            let name = format!("{rel} {}{hidden}{sampler}", s.label());
+            assert_eq!(sums[0], sums[1], "{name}: 1 and 2 threads differ");
             let [one, _] = sums;
-            got.insert(format!("{rel} {}{hidden}", s.label()), one);
+            got.insert(name, one);
         }
     }
     let text: String = got.iter().map(|(k, v)| format!("{k} {v}\n")).collect();

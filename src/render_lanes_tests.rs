@@ -7,8 +7,34 @@ use crate::rng::Rng;
 use crate::scene::desc::{Heuristic, StrategyKind};
 use glam::Vec3;
 
-/// Renders `scene` and recomputes every pixel from its definition: generator
-/// `for_sample(seed, pixel, s)`, `generate_ray`, `li`, one sample at a time. The first pixel
+/// The values of samples `0 .. spp` of pixel (x, y) by their definition, one sample at a
+/// time: the sampler's sample s (lane 0 of a batch that starts at s), `generate_ray`, `li`.
+struct PerSample<'a> {
+    scene: &'a Scene,
+    direct: &'a crate::integrator::Direct<'a>,
+    cfg: SamplerConfig,
+    x: u32,
+    y: u32,
+    spp: u32,
+}
+
+impl LanesVisitor for PerSample<'_> {
+    type Output = Vec<Vec3>;
+    fn visit<L: SamplerLanes>(self) -> Vec<Vec3> {
+        let pixel = L::pixel(&self.cfg, self.x, self.y);
+        (0..self.spp)
+            .map(|s| {
+                let mut one = L::start(pixel, s as u64).lane(0);
+                let ray = self.scene.camera.generate_ray(self.x, self.y, &mut one);
+                self.direct.li(&ray, &mut one)
+            })
+            .collect()
+    }
+}
+
+/// Renders `scene` and recomputes every pixel from its definition: the sampler's sample
+/// (for `independent`, generator `for_sample(seed, pixel, s)`), `generate_ray`, `li`, one
+/// sample at a time. The first pixel
 /// whose mean or variance differs in any bit is the error; otherwise the count of lit pixels.
 fn per_sample_mismatch(
     scene: &Scene,
@@ -18,18 +44,30 @@ fn per_sample_mismatch(
     let out = render(scene, strategy, settings);
     let direct = crate::integrator::Direct::new(scene, strategy);
     let cam = &scene.camera;
+    let cfg = settings.sampler_config(cam.width)?;
     let mut lit = 0;
     for y in 0..cam.height {
         for x in 0..cam.width {
-            let pixel = y as u64 * cam.width as u64 + x as u64;
+            if settings.sampling.kind == crate::sampler::SamplerKind::Independent {
+                // The visitor's definition is the generator's own for this sampler.
+                let pixel = y as u64 * cam.width as u64 + x as u64;
+                let mut a = Rng::for_sample(settings.seed, pixel, 3);
+                let mut b = <crate::sampler::IndependentLanes as SamplerLanes>::start(
+                    Rng::pixel_key(settings.seed, pixel),
+                    3,
+                )
+                .lane(0);
+                assert_eq!(a.next_u32(), b.next_u32());
+            }
             let mut st = PixelStats::default();
-            let li: Vec<Vec3> = (0..settings.spp)
-                .map(|s| {
-                    let mut rng = Rng::for_sample(settings.seed, pixel, s as u64);
-                    let ray = cam.generate_ray(x, y, &mut rng);
-                    direct.li(&ray, &mut rng)
-                })
-                .collect();
+            let li = settings.sampling.kind.visit(PerSample {
+                scene,
+                direct: &direct,
+                cfg,
+                x,
+                y,
+                spp: settings.spp,
+            });
             for batch in li.chunks(LANES) {
                 let v = std::array::from_fn(|i| batch.get(i).copied().unwrap_or_default());
                 st.push_batch(&v, batch.len());
@@ -159,6 +197,7 @@ fn lane_samples_are_bitwise_the_per_sample_definition() {
             first_sample: 0,
             threads: Some(1),
             progress: false,
+            sampling: Default::default(),
         };
         let kernel = LaneKernel::new(&scene, strategy);
         assert_eq!(kernel.has_lanes(), lanes, "{rel}: lane coverage");
@@ -221,12 +260,29 @@ fn random_scenes_render_bitwise_as_their_per_sample_definition() {
         let kernel = LaneKernel::new(&scene, strategy);
         let want = covered.contains(&strategy) && r.features.point_lights == 0;
         assert_eq!(kernel.has_lanes(), want, "seed {seed}: lane coverage");
+        // Every sampler and allocation: the lanes draw each sample's numbers as the scalar
+        // path does.
+        let sampling = crate::sampler::Sampling {
+            kind: crate::sampler::SamplerKind::ALL
+                [seed as usize % crate::sampler::SamplerKind::ALL.len()],
+            dims: [
+                crate::sampler::DimAlloc::Joint,
+                crate::sampler::DimAlloc::Padded,
+            ][(seed / 4 % 2) as usize],
+            run_samples: None,
+        };
+        tally(format!(
+            "sampler {} {}",
+            sampling.kind.name(),
+            sampling.dims.name()
+        ));
         let settings = RenderSettings {
             spp: 11,
             seed: seed ^ 0xabc,
             first_sample: 0,
             threads: Some(1),
             progress: false,
+            sampling,
         };
         let lit = per_sample_mismatch(&scene, strategy, &settings)
             .unwrap_or_else(|e| panic!("seed {seed} ({strategy:?}): {e}"));
@@ -275,6 +331,11 @@ fn random_scenes_render_bitwise_as_their_per_sample_definition() {
         "lights over 8".into(),
         "lights up to 8".into(),
     ];
+    for kind in crate::sampler::SamplerKind::ALL {
+        for dims in ["joint", "padded"] {
+            want.push(format!("sampler {} {dims}", kind.name()));
+        }
+    }
     for m in [
         "diffuse",
         "rough-beckmann-grey",

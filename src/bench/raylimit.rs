@@ -430,6 +430,7 @@ pub fn measure_interleaved(
         first_sample: 0,
         threads: Some(1),
         progress: false,
+        sampling: Default::default(),
     };
     let bands: Vec<_> = (0..h)
         .step_by(BAND_ROWS as usize)

@@ -48,6 +48,7 @@ pub fn throughputs(
             first_sample: 0,
             threads: Some(t),
             progress: false,
+            sampling: Default::default(),
         };
         let out = render(scene, strategy, &settings);
         (out.seconds, out.busy_seconds)

@@ -214,6 +214,9 @@ pub fn render_chunked(dir: &Path, r: &ChunkedRender) -> Result<Accum, String> {
                 first_sample: first,
                 threads: r.threads,
                 progress: r.progress,
+                // References draw independent samples: their chunks merge as independent
+                // estimates whatever the sweep's samplers.
+                sampling: Default::default(),
             },
         );
         let chunk = Accum::of(&out);
@@ -318,6 +321,7 @@ mod tests {
                 first_sample: 0,
                 threads: Some(1),
                 progress: false,
+                sampling: Default::default(),
             },
         ));
         // Marked by its time, so that the resumed run shows it started from the checkpoint.

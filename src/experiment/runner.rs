@@ -62,6 +62,7 @@ fn execute(ctx: &Ctx, job: &Job) -> Result<Row, String> {
             first_sample: 0,
             threads: ctx.threads,
             progress: false,
+            sampling: Default::default(),
         },
     );
     if let Some(p) = &job.image {

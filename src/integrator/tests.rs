@@ -49,6 +49,7 @@ pub(crate) fn settings(spp: u32, seed: u64) -> RenderSettings {
         first_sample: 0,
         threads: None,
         progress: false,
+        sampling: Default::default(),
     }
 }
 

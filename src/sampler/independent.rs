@@ -1,7 +1,7 @@
 //! `independent`: every number drawn fresh from the sample's own PCG32 generator
 //! (`Rng::for_pixel_sample`), group after group in the order of the dimension allocation.
 
-use super::{BsdfDims, LightDims, Sampler, SamplerLanes};
+use super::{BsdfDims, LightDims, Sampler, SamplerConfig, SamplerLanes};
 use crate::rng::{Rng, LANES};
 use glam::Vec2;
 
@@ -77,8 +77,8 @@ impl SamplerLanes for IndependentLanes {
     type Pixel = u64;
 
     #[inline]
-    fn pixel(seed: u64, pixel: u64) -> u64 {
-        Rng::pixel_key(seed, pixel)
+    fn pixel(cfg: &SamplerConfig, x: u32, y: u32) -> u64 {
+        Rng::pixel_key(cfg.seed, cfg.pixel_index(x, y))
     }
 
     #[inline]
@@ -136,7 +136,13 @@ mod tests {
     #[test]
     fn groups_draw_the_stream_in_allocation_order() {
         let key = Rng::pixel_key(5, 77);
-        let mut lanes = IndependentLanes::start(IndependentLanes::pixel(5, 77), 16);
+        let cfg = SamplerConfig {
+            dims: crate::sampler::DimAlloc::Joint,
+            seed: 5,
+            run_samples: 64,
+            width: 100,
+        };
+        let mut lanes = IndependentLanes::start(IndependentLanes::pixel(&cfg, 77, 0), 16);
         let [fx, fy] = lanes.film();
         let [sel, prim, px, py] = lanes.light();
         let [lobe, dx, dy] = lanes.bsdf();

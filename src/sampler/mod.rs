@@ -31,11 +31,166 @@
 //! after each light group, for the paths only its delta lobe makes.
 
 pub mod independent;
+pub mod permute;
+pub mod pure;
+pub mod sobol;
+pub mod stratified;
 
 use crate::rng::LANES;
 use glam::Vec2;
 
 pub use independent::IndependentLanes;
+pub use pure::{PointSet, PureLanes, PureSample};
+
+/// The samplers a render can draw its numbers from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SamplerKind {
+    /// Every number from the sample's own PCG32 generator.
+    #[default]
+    Independent,
+    /// Jittered strata, one permutation of the strata per pixel and dimension (padded).
+    Stratified,
+    /// Owen-scrambled Sobol' points (Burley's hash), re-seeded per group of dimensions.
+    Sobol,
+    /// The same Sobol' points with a random digital shift (XOR) only: the control that
+    /// shows what Owen scrambling buys.
+    #[value(name = "sobol-xor")]
+    #[serde(rename = "sobol-xor")]
+    SobolXor,
+}
+
+impl SamplerKind {
+    pub const ALL: [SamplerKind; 4] = [
+        SamplerKind::Independent,
+        SamplerKind::Stratified,
+        SamplerKind::Sobol,
+        SamplerKind::SobolXor,
+    ];
+
+    /// The name the CLI, scene files and experiment files use.
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerKind::Independent => "independent",
+            SamplerKind::Stratified => "stratified",
+            SamplerKind::Sobol => "sobol",
+            SamplerKind::SobolXor => "sobol-xor",
+        }
+    }
+
+    /// Whether the sampler must know the run's sample count in advance (its strata).
+    pub fn needs_sample_count(self) -> bool {
+        self == SamplerKind::Stratified
+    }
+}
+
+/// How a sample's groups of numbers take their dimensions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DimAlloc {
+    /// Each group (film, light sample, BSDF sample) is one point of a joint set of up to 4
+    /// dimensions: a light sample's emitter choice and point on the light are stratified
+    /// together.
+    #[default]
+    Joint,
+    /// Each 1D or 2D draw is its own, independently randomised set (pbrt's PaddedSobol and
+    /// every stratified sampler): stratified per draw, not jointly.
+    Padded,
+}
+
+impl DimAlloc {
+    pub fn name(self) -> &'static str {
+        match self {
+            DimAlloc::Joint => "joint",
+            DimAlloc::Padded => "padded",
+        }
+    }
+}
+
+/// A render's choice of sampler.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Sampling {
+    pub kind: SamplerKind,
+    pub dims: DimAlloc,
+    /// Samples per pixel of the whole run when a render is one chunk of it (a reference's
+    /// chunks); None: the render's own `first_sample + spp`.
+    pub run_samples: Option<u64>,
+}
+
+impl Sampling {
+    /// The configuration of a render of samples `first .. first + spp`, or why the sampler
+    /// cannot draw them.
+    pub fn config(
+        &self,
+        seed: u64,
+        first: u64,
+        spp: u32,
+        width: u32,
+    ) -> Result<SamplerConfig, String> {
+        let end = first + spp as u64;
+        let run_samples = self.run_samples.unwrap_or(end);
+        if self.kind.needs_sample_count() {
+            if end > run_samples {
+                return Err(format!(
+                    "the {} sampler's strata are laid out for {run_samples} samples per pixel, \
+                     but samples {first}..{end} were asked for",
+                    self.kind.name()
+                ));
+            }
+            if run_samples > stratified::MAX_SAMPLES {
+                return Err(format!(
+                    "the {} sampler takes at most {} samples per pixel ({run_samples} asked for)",
+                    self.kind.name(),
+                    stratified::MAX_SAMPLES
+                ));
+            }
+        }
+        Ok(SamplerConfig {
+            dims: self.dims,
+            seed,
+            run_samples,
+            width,
+        })
+    }
+}
+
+/// Code generic over the lane sampler, run for a [`SamplerKind`] by
+/// [`SamplerKind::visit`]: the one place a sampler is registered for rendering.
+pub trait LanesVisitor {
+    type Output;
+    fn visit<L: SamplerLanes>(self) -> Self::Output;
+}
+
+impl SamplerKind {
+    #[inline(always)]
+    pub fn visit<V: LanesVisitor>(self, v: V) -> V::Output {
+        match self {
+            SamplerKind::Independent => v.visit::<IndependentLanes>(),
+            SamplerKind::Stratified => v.visit::<stratified::StratifiedLanes>(),
+            SamplerKind::Sobol => v.visit::<sobol::SobolLanes>(),
+            SamplerKind::SobolXor => v.visit::<sobol::SobolXorLanes>(),
+        }
+    }
+}
+
+/// What every sampler of a render knows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SamplerConfig {
+    pub dims: DimAlloc,
+    pub seed: u64,
+    /// Samples per pixel of the whole run (all chunks of a reference): a stratified
+    /// sampler's strata.
+    pub run_samples: u64,
+    /// The film's width, which numbers the pixels.
+    pub width: u32,
+}
+
+impl SamplerConfig {
+    /// The pixel's index in the film, row by row.
+    pub fn pixel_index(&self, x: u32, y: u32) -> u64 {
+        y as u64 * self.width as u64 + x as u64
+    }
+}
 
 /// The numbers of one light sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,7 +227,7 @@ pub trait SamplerLanes: Clone {
     type One: Sampler;
     /// What the samples of one pixel share, computed once per pixel.
     type Pixel: Copy;
-    fn pixel(seed: u64, pixel: u64) -> Self::Pixel;
+    fn pixel(cfg: &SamplerConfig, x: u32, y: u32) -> Self::Pixel;
     /// Samples `s0 .. s0 + LANES` of the pixel.
     fn start(pixel: Self::Pixel, s0: u64) -> Self;
     fn film(&mut self) -> [[f32; LANES]; 2];

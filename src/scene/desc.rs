@@ -71,6 +71,8 @@ pub struct FilmDesc {
 pub struct SamplerDesc {
     pub sample_count: u32,
     pub seed: u64,
+    /// The directlab sampler the scene's `<sampler type>` maps to.
+    pub kind: crate::sampler::SamplerKind,
 }
 
 /// How a direct-lighting estimator combines its techniques; scenes name one, the CLI may

@@ -25,6 +25,7 @@ fn base(camera: Mat4, fov: f32, width: u32, height: u32, shapes: Vec<ShapeDesc>)
         sampler: SamplerDesc {
             sample_count: 16,
             seed: 0,
+            kind: Default::default(),
         },
         integrator: IntegratorDesc {
             strategy: StrategyKind::Light,

@@ -231,6 +231,7 @@ impl<'a> Loader<'a> {
             (a, b) => a.or(b).unwrap_or(SamplerDesc {
                 sample_count: if self.is_nori() { 1 } else { 4 },
                 seed: 0,
+                kind: Default::default(),
             }),
         };
         let film = film.unwrap_or(self.default_film());

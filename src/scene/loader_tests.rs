@@ -87,7 +87,8 @@ fn mitsuba3_defaults() {
         s.sampler,
         SamplerDesc {
             sample_count: 4,
-            seed: 0
+            seed: 0,
+            kind: crate::sampler::SamplerKind::Independent,
         }
     );
     assert_eq!(
@@ -152,7 +153,8 @@ fn mitsuba3_sensor_film_sampler_integrator() {
         s.sampler,
         SamplerDesc {
             sample_count: 16,
-            seed: 3
+            seed: 3,
+            kind: crate::sampler::SamplerKind::Independent,
         }
     );
     assert_eq!((s.film.width, s.film.height), (64, 32));
@@ -460,4 +462,47 @@ fn focal_length_gives_a_diagonal_fov_like_mitsuba() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("not both"), "{e}");
+}
+
+/// Scene samplers map to directlab's: its own names as they are, Mitsuba's others to the
+/// nearest one with a warning that names both; an unknown type is an error that lists them.
+#[test]
+fn sampler_types_map_to_the_nearest_directlab_sampler() {
+    use crate::sampler::SamplerKind::*;
+    for (ty, kind, warned) in [
+        ("independent", Independent, false),
+        ("stratified", Stratified, false),
+        ("sobol", Sobol, false),
+        ("sobol-xor", SobolXor, false),
+        ("multijitter", Stratified, true),
+        ("orthogonal", Stratified, true),
+        ("ldsampler", Sobol, true),
+    ] {
+        let xml = format!(
+            r#"<scene version="3.0.0"><sensor type="perspective"><float name="fov" value="45"/>
+            <sampler type="{ty}"><integer name="sample_count" value="16"/>
+            <boolean name="jitter" value="true"/></sampler></sensor>{LIGHT}</scene>"#
+        );
+        let s = load(&xml).unwrap_or_else(|e| panic!("{ty}: {e}"));
+        assert_eq!(s.sampler.kind, kind, "{ty}");
+        assert_eq!(s.sampler.sample_count, 16);
+        let nearest = s.warnings.iter().any(|w| {
+            w.contains(&format!(
+                "sampler '{ty}' is rendered by directlab's '{}'",
+                kind.name()
+            )) && w.contains("nearest")
+        });
+        assert_eq!(nearest, warned, "{ty}: {:?}", s.warnings);
+        assert!(
+            s.warnings.iter().any(|w| w.contains("jitter")),
+            "{ty}: {:?}",
+            s.warnings
+        );
+    }
+    let xml = format!(r#"<scene version="3.0.0">{SENSOR}<sampler type="pmj"/>{LIGHT}</scene>"#);
+    let e = load(&xml).unwrap_err().to_string();
+    assert!(
+        e.contains("pmj") && e.contains("sobol-xor") && e.contains("test.xml"),
+        "{e}"
+    );
 }

@@ -494,6 +494,7 @@ pub fn random_scene(seed: u64, dir: &Path) -> RandomScene {
         sampler: SamplerDesc {
             sample_count: 8,
             seed,
+            kind: Default::default(),
         },
         integrator: IntegratorDesc {
             strategy: StrategyKind::Mis,

@@ -333,27 +333,53 @@ impl<'a> Loader<'a> {
         let default_count = if self.is_nori() { 1 } else { 4 };
         let sample_count = p.count("sample_count")?.unwrap_or(default_count);
         let seed = p.count("seed")?.unwrap_or(0) as u64;
-        match p.ty.as_str() {
-            "independent" => p.finish()?,
-            // The sampler type only changes noise, not the mean: keep the sample count and say so.
-            t if KNOWN_SAMPLERS.contains(&t) => {
-                for key in [
-                    "dimension",
-                    "jitter",
-                    "scramble",
-                    "scramble_seed",
-                    "resolution",
-                ] {
-                    p.ignore(key, "sampler replaced by 'independent'", &mut self.warnings);
-                }
-                p.finish()?;
-                self.warn(e, format!("sampler '{t}' replaced by 'independent'"));
+        use crate::sampler::SamplerKind;
+        let (kind, nearest) = match p.ty.as_str() {
+            "independent" => (SamplerKind::Independent, false),
+            "stratified" => (SamplerKind::Stratified, false),
+            "sobol" => (SamplerKind::Sobol, false),
+            "sobol-xor" => (SamplerKind::SobolXor, false),
+            "multijitter" | "orthogonal" => (SamplerKind::Stratified, true),
+            "ldsampler" | "low_discrepancy" | "halton" | "hammersley" => (SamplerKind::Sobol, true),
+            t if KNOWN_SAMPLERS.contains(&t) => (SamplerKind::Independent, true),
+            t => {
+                return Err(unknown(
+                    e,
+                    "sampler",
+                    t,
+                    "independent, stratified, sobol, sobol-xor (or Mitsuba's multijitter, \
+                     orthogonal, ldsampler)",
+                ))
             }
-            t => return Err(unknown(e, "sampler", t, "independent")),
+        };
+        let why = format!(
+            "sampler '{}' is rendered by directlab's '{}'",
+            p.ty,
+            kind.name()
+        );
+        for key in [
+            "dimension",
+            "jitter",
+            "scramble",
+            "scramble_seed",
+            "resolution",
+        ] {
+            p.ignore(key, &why, &mut self.warnings);
+        }
+        p.finish()?;
+        if nearest {
+            self.warn(
+                e,
+                format!("{why}, the nearest one (same mean, different noise and convergence)"),
+            );
         }
         if sample_count == 0 {
             return Err(e.err("sample_count must be at least 1"));
         }
-        Ok(SamplerDesc { sample_count, seed })
+        Ok(SamplerDesc {
+            sample_count,
+            seed,
+            kind,
+        })
     }
 }

@@ -47,6 +47,7 @@ pub fn measure(
         first_sample: 0,
         threads,
         progress: false,
+        sampling: Default::default(),
     };
     let out = render(scene, s, &settings);
     let px = out.mean.data.len() as f64;

@@ -74,6 +74,7 @@ mod tests {
             first_sample: 0,
             threads: Some(1),
             progress: false,
+            sampling: Default::default(),
         };
         let img = render(&scene, s, &settings);
         let direct = Direct::new(&scene, s);

@@ -1,0 +1,258 @@
+//! `sobol` and `sobol-xor`: Sobol' points in groups of up to four dimensions, each group
+//! (or, padded, each 1D/2D draw) taking the sequence's first four dimensions under its own
+//! randomisation, seeded by (seed, pixel, dimension): Burley's padding by re-seeded low
+//! dimensions, so no group sees the poor projections of high Sobol' dimensions and the
+//! number of dimensions is unbounded.
+//!
+//! - `sobol` (`Sobol<true>`): sobol_burley's Owen scrambling by hashing, with its seeded
+//!   shuffle of the sample order (a nested scramble of the index, which keeps every aligned
+//!   block of 2^m samples a (0, m, 2)-net).
+//! - `sobol-xor` (`Sobol<false>`): the unshuffled sequence with a random digital shift (XOR
+//!   of all bits) per dimension: unbiased, the same strata, but a much weaker randomisation.
+//!
+//! **2^16 samples per seed.** sobol_burley's sequence has 2^16 points (the crate silently
+//! wraps past them in release builds). Sample index `s` is point `s mod 2^16` of
+//! randomisation `s / 2^16`: each block of 65,536 samples is an independent randomisation
+//! of the whole sequence (its own seeds), never a repeat of the first block. Renders of up
+//! to 65,536 samples per pixel see one Sobol' sequence; longer ones (references) are
+//! averages of independent RQMC estimates, which converge at least at the Monte Carlo rate.
+
+use super::pure::{PointSet, PureLanes};
+use super::SamplerConfig;
+use crate::rng::{mix64, Rng};
+use sobol_burley::parts::{sobol_int4_rev, u32_to_f32_norm};
+
+/// Samples per randomisation: the length of sobol_burley's sequence.
+pub const BLOCK: u64 = 1 << 16;
+
+/// The Sobol' family: Owen-scrambled (`OWEN = true`) or digitally shifted.
+#[derive(Clone, Copy, Debug)]
+pub struct Sobol<const OWEN: bool>;
+
+pub type SobolLanes = PureLanes<Sobol<true>>;
+pub type SobolXorLanes = PureLanes<Sobol<false>>;
+
+/// The randomisation of dimensions `dim ..` in block `block` of a pixel.
+#[inline(always)]
+fn seed_of(pixel: u64, dim: u32, block: u64) -> u64 {
+    mix64(mix64(pixel ^ dim as u64) ^ block)
+}
+
+impl<const OWEN: bool> PointSet for Sobol<OWEN> {
+    type Pixel = u64;
+    const JOINT: bool = true;
+
+    fn pixel(cfg: &SamplerConfig, x: u32, y: u32) -> u64 {
+        // Salted: the same seed gives the Sobol' samplers and `independent` unrelated keys.
+        mix64(Rng::pixel_key(cfg.seed, cfg.pixel_index(x, y)) ^ 0x50b0_1000_0000_0001)
+    }
+
+    #[inline(always)]
+    fn draw(pixel: &u64, index: u64, dim: u32, _k: usize) -> [f32; 4] {
+        let (block, i) = (index / BLOCK, (index % BLOCK) as u32);
+        let seed = seed_of(*pixel, dim, block);
+        if OWEN {
+            sobol_burley::sample_4d(i, 0, (seed >> 32) as u32)
+        } else {
+            let v: [u32; 4] = sobol_int4_rev(i.reverse_bits(), 0).reverse_bits().into();
+            let shift = [
+                seed as u32,
+                (seed >> 32) as u32,
+                mix64(seed) as u32,
+                (mix64(seed) >> 32) as u32,
+            ];
+            std::array::from_fn(|j| u32_to_f32_norm(v[j] ^ shift[j]))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::LANES;
+    use crate::sampler::pure::PureSample;
+    use crate::sampler::{DimAlloc, Sampler, SamplerLanes};
+
+    fn cfg(seed: u64, dims: DimAlloc) -> SamplerConfig {
+        SamplerConfig {
+            dims,
+            seed,
+            run_samples: 1 << 20,
+            width: 64,
+        }
+    }
+
+    /// The film pair of samples `first .. first + 2^m` of a pixel.
+    fn film_points<const OWEN: bool>(
+        c: &SamplerConfig,
+        x: u32,
+        first: u64,
+        m: u32,
+    ) -> Vec<(f32, f32)> {
+        let px = PureLanes::<Sobol<OWEN>>::pixel(c, x, 3);
+        (first..first + (1 << m))
+            .map(|s| {
+                let f = PureSample::new(px, s).film();
+                (f.x, f.y)
+            })
+            .collect()
+    }
+
+    /// Every 2^i x 2^(m-i) elementary box holds exactly one of the 2^m points.
+    fn is_02_net(points: &[(f32, f32)], m: u32) -> bool {
+        (0..=m).all(|i| {
+            let (nx, ny) = (1u64 << i, 1u64 << (m - i));
+            let mut count = vec![0u32; 1 << m];
+            for &(x, y) in points {
+                let (bx, by) = ((x as f64 * nx as f64) as u64, (y as f64 * ny as f64) as u64);
+                count[(by * nx + bx) as usize] += 1;
+            }
+            count.iter().all(|&c| c == 1)
+        })
+    }
+
+    #[test]
+    fn aligned_blocks_of_film_samples_are_02_nets() {
+        for m in 0..=10 {
+            for (seed, x) in [(0, 0), (7, 5), (123_456, 63)] {
+                let c = cfg(seed, DimAlloc::Joint);
+                for first in [0, 1 << m, 5 << m, BLOCK, 3 * BLOCK + (2 << m)] {
+                    assert!(
+                        is_02_net(&film_points::<true>(&c, x, first, m), m),
+                        "owen m={m} first={first}"
+                    );
+                    assert!(
+                        is_02_net(&film_points::<false>(&c, x, first, m), m),
+                        "xor m={m} first={first}"
+                    );
+                }
+            }
+        }
+        // The check itself: 4 independent points are not a net.
+        let c = cfg(1, DimAlloc::Joint);
+        let mut r = Rng::for_sample(1, 2, 3);
+        let random: Vec<(f32, f32)> = (0..16).map(|_| (r.next_f32(), r.next_f32())).collect();
+        assert!(!is_02_net(&random, 4));
+        assert!(is_02_net(&film_points::<true>(&c, 0, 0, 4), 4));
+    }
+
+    #[test]
+    fn owen_values_are_sobol_burleys() {
+        let p = 0x1234_5678_9abc_def0;
+        for (index, dim) in [(0u64, 0u32), (1, 4), (1000, 9), (65535, 2)] {
+            let seed = (seed_of(p, dim, 0) >> 32) as u32;
+            let want: Vec<f32> = (0..4)
+                .map(|j| sobol_burley::sample(index as u32, j, seed))
+                .collect();
+            assert_eq!(Sobol::<true>::draw(&p, index, dim, 4).to_vec(), want);
+        }
+    }
+
+    /// Past 2^16 samples the sequence is re-randomised, not repeated.
+    #[test]
+    fn sample_65536_is_not_sample_0() {
+        for owen in [true, false] {
+            for dim in [0, 2, 13] {
+                let (a, b) = if owen {
+                    (
+                        Sobol::<true>::draw(&9, 0, dim, 4),
+                        Sobol::<true>::draw(&9, BLOCK, dim, 4),
+                    )
+                } else {
+                    (
+                        Sobol::<false>::draw(&9, 0, dim, 4),
+                        Sobol::<false>::draw(&9, BLOCK, dim, 4),
+                    )
+                };
+                assert_ne!(a, b, "owen {owen} dim {dim}");
+            }
+        }
+    }
+
+    /// Every dimension of every group changes with the seed, in both allocations.
+    #[test]
+    fn every_dimension_changes_with_the_seed() {
+        for dims in [DimAlloc::Joint, DimAlloc::Padded] {
+            let draw = |seed: u64| {
+                let px = SobolLanes::pixel(&cfg(seed, dims), 2, 2);
+                let mut s = PureSample::new(px, 3);
+                let (f, t, l, b) = (s.film(), s.technique(), s.light(), s.bsdf());
+                [
+                    f.x,
+                    f.y,
+                    t,
+                    l.select,
+                    l.primitive,
+                    l.point.x,
+                    l.point.y,
+                    b.lobe,
+                    b.direction.x,
+                    b.direction.y,
+                ]
+            };
+            let (a, b) = (draw(1), draw(2));
+            for k in 0..a.len() {
+                assert_ne!(a[k], b[k], "{dims:?}: dimension {k}");
+            }
+        }
+    }
+
+    /// Lanes give each sample exactly the scalar sample's numbers, whatever order the
+    /// samples are visited in.
+    #[test]
+    fn lanes_match_scalar_samples_in_any_order() {
+        for dims in [DimAlloc::Joint, DimAlloc::Padded] {
+            let c = cfg(5, dims);
+            let px = SobolXorLanes::pixel(&c, 1, 1);
+            let mut lanes = SobolXorLanes::start(px, 16);
+            let film = lanes.film();
+            let light = lanes.light();
+            let bsdf = lanes.bsdf();
+            for i in (0..LANES).rev() {
+                let mut one = PureSample::new(px, 16 + i as u64);
+                let (f, l, b) = (one.film(), one.light(), one.bsdf());
+                assert_eq!([film[0][i], film[1][i]], [f.x, f.y]);
+                assert_eq!(
+                    [light[0][i], light[1][i], light[2][i], light[3][i]],
+                    [l.select, l.primitive, l.point.x, l.point.y]
+                );
+                assert_eq!(
+                    [bsdf[0][i], bsdf[1][i], bsdf[2][i]],
+                    [b.lobe, b.direction.x, b.direction.y]
+                );
+                assert_eq!(lanes.lane(i).dimension(), one.dimension());
+            }
+        }
+    }
+
+    /// Joint: a light sample's four numbers are one 4D Sobol' point, so its emitter choice
+    /// and its point are stratified together; padded: the choice and the point come from
+    /// independent randomisations.
+    #[test]
+    fn joint_light_groups_are_one_sobol_point() {
+        let joint = cfg(3, DimAlloc::Joint);
+        let padded = cfg(3, DimAlloc::Padded);
+        let (pj, pp) = (
+            SobolLanes::pixel(&joint, 0, 0),
+            SobolLanes::pixel(&padded, 0, 0),
+        );
+        for s in 0..64 {
+            let mut a = PureSample::new(pj, s);
+            a.film();
+            let l = a.light();
+            assert_eq!(
+                [l.select, l.primitive, l.point.x, l.point.y],
+                Sobol::<true>::draw(&pj.inner, s, 2, 4)
+            );
+            let mut b = PureSample::new(pp, s);
+            b.film();
+            let l = b.light();
+            assert_eq!(l.select, Sobol::<true>::draw(&pp.inner, s, 2, 1)[0]);
+            assert_eq!(l.primitive, Sobol::<true>::draw(&pp.inner, s, 3, 1)[0]);
+            assert_eq!(
+                [l.point.x, l.point.y],
+                Sobol::<true>::draw(&pp.inner, s, 4, 2)[..2]
+            );
+        }
+    }
+}
