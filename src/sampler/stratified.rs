@@ -60,8 +60,9 @@ impl PointSet for Stratified {
 
     #[inline(always)]
     fn draw(px: &StrataPixel, index: u64, dim: u32, k: usize) -> [f32; 4] {
-        debug_assert!(index < px.n as u64, "sample {index} of a run of {}", px.n);
-        let i = index as u32;
+        // Lanes past the run's last sample (a partial batch) are drawn and dropped; they
+        // must not reach `permute` as they are, whose cycle walk need not end for i >= n.
+        let i = (index % px.n as u64) as u32;
         let dim_key = mix64(px.key ^ dim as u64);
         let perm_seed = (dim_key >> 32) as u32;
         let jitter = mix64(dim_key ^ index);
@@ -140,6 +141,23 @@ mod tests {
             );
             if a as u64 * b as u64 == n {
                 assert!(film.iter().all(|&c| c == 1), "n = {n}");
+            }
+        }
+    }
+
+    /// A partial batch draws lanes past the run's samples; they must return (the cycle walk
+    /// of the permutation hung on them: 11 spp rendered forever).
+    #[test]
+    fn lanes_past_the_run_still_draw() {
+        for n in [1u64, 3, 11, 17] {
+            let px = pixel(n, 4);
+            for s in n..n + 8 {
+                for dim in 0..40 {
+                    for k in [1, 2] {
+                        let v = Stratified::draw(&px.inner, s, dim, k);
+                        assert!(v.iter().all(|v| (0.0..1.0).contains(v)));
+                    }
+                }
             }
         }
     }
