@@ -48,17 +48,6 @@ fn per_sample_mismatch(
     let mut lit = 0;
     for y in 0..cam.height {
         for x in 0..cam.width {
-            if settings.sampling.kind == crate::sampler::SamplerKind::Independent {
-                // The visitor's definition is the generator's own for this sampler.
-                let pixel = y as u64 * cam.width as u64 + x as u64;
-                let mut a = Rng::for_sample(settings.seed, pixel, 3);
-                let mut b = <crate::sampler::IndependentLanes as SamplerLanes>::start(
-                    Rng::pixel_key(settings.seed, pixel),
-                    3,
-                )
-                .lane(0);
-                assert_eq!(a.next_u32(), b.next_u32());
-            }
             let mut st = PixelStats::default();
             let li = settings.sampling.kind.visit(PerSample {
                 scene,

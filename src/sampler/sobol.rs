@@ -55,11 +55,12 @@ impl<const OWEN: bool> PointSet for Sobol<OWEN> {
             sobol_burley::sample_4d(i, 0, (seed >> 32) as u32)
         } else {
             let v: [u32; 4] = sobol_int4_rev(i.reverse_bits(), 0).reverse_bits().into();
+            let more = mix64(seed);
             let shift = [
                 seed as u32,
                 (seed >> 32) as u32,
-                mix64(seed) as u32,
-                (mix64(seed) >> 32) as u32,
+                more as u32,
+                (more >> 32) as u32,
             ];
             std::array::from_fn(|j| u32_to_f32_norm(v[j] ^ shift[j]))
         }
