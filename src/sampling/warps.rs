@@ -206,6 +206,20 @@ mod tests {
         assert_eq!(sin_cos_turns(0.75), (-1.0, 0.0));
     }
 
+    /// The concentric map on the square's axes (where one of the wedge ratio's terms is 0)
+    /// and at its centre, by hand: the axes map onto the disk's axes, the centre to 0.
+    #[test]
+    fn concentric_disk_on_the_axes() {
+        let d = |x: f32, y: f32| square_to_concentric_disk(Vec2::new(x, y));
+        assert_eq!(d(0.5, 0.5), Vec2::ZERO);
+        for (t, r) in [(0.9f32, 0.8f32), (0.1, -0.8), (1.0, 1.0)] {
+            let on_x = d(t, 0.5);
+            let on_y = d(0.5, t);
+            assert!((on_x - Vec2::new(r, 0.0)).length() < 1e-6, "{on_x}");
+            assert!((on_y - Vec2::new(0.0, r)).length() < 1e-6, "{on_y}");
+        }
+    }
+
     #[test]
     fn quarter_sin_cos_within_a_few_ulp() {
         let n = 100_000;
