@@ -288,3 +288,47 @@ fn slope_step_converges_by_each_rule() {
     assert_eq!(next, 0.5 * (lo2 + hi2), "a step out of the bracket bisects");
     assert!(done, "a bracket below its bound converges");
 }
+
+/// The full-distribution sampler's slope-space convention (module doc): slope (x, y) =
+/// r (alpha_u cos 2 pi u1, alpha_v sin 2 pi u1) and m = normalize(-x, -y, 1). The density
+/// is symmetric, so the chi-square cannot see a flipped sign; images sampled with a seed
+/// would change.
+#[test]
+fn full_sampler_follows_the_slope_convention() {
+    for d in DISTS {
+        let mf = Microfacet::new(d, 0.3, 0.6);
+        for (u0, u1) in [(0.5f32, 0.1f32), (0.2, 0.3), (0.7, 0.6), (0.4, 0.85)] {
+            let r = match d {
+                MicrofacetDistribution::Beckmann => (-(1.0 - u0 as f64).ln()).sqrt(),
+                MicrofacetDistribution::Ggx => (u0 as f64 / (1.0 - u0 as f64)).sqrt(),
+            };
+            let phi = std::f64::consts::TAU * u1 as f64;
+            let want = DVec3::new(-r * phi.cos() * 0.3, -r * phi.sin() * 0.6, 1.0).normalize();
+            let m = mf.sample_all(Vec2::new(u0, u1)).as_dvec3();
+            assert!(
+                (m - want).length() < 1e-6,
+                "{d:?} u ({u0}, {u1}): {m} vs {want}"
+            );
+        }
+    }
+}
+
+/// Heitz's GGX visible-normal sampler at normal incidence, in closed form: the disk point
+/// sqrt(u0) (cos 2 pi u1, sin 2 pi u1) lifted to the hemisphere and unstretched. (Its density
+/// is symmetric in the azimuth, so only this pins the sign of the second disk coordinate.)
+#[test]
+fn ggx_visible_sampler_at_normal_incidence_in_closed_form() {
+    let mf = Microfacet::new(MicrofacetDistribution::Ggx, 0.3, 0.6);
+    for (u0, u1) in [(0.5f32, 0.1f32), (0.2, 0.3), (0.7, 0.6), (0.4, 0.85)] {
+        let r = (u0 as f64).sqrt();
+        let phi = std::f64::consts::TAU * u1 as f64;
+        let want = DVec3::new(
+            0.3 * r * phi.cos(),
+            0.6 * r * phi.sin(),
+            (1.0 - r * r).sqrt(),
+        )
+        .normalize();
+        let m = mf.sample_visible(Vec3::Z, Vec2::new(u0, u1)).as_dvec3();
+        assert!((m - want).length() < 1e-6, "u ({u0}, {u1}): {m} vs {want}");
+    }
+}

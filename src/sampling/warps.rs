@@ -130,9 +130,10 @@ pub fn square_to_uniform_hemisphere(u: Vec2) -> Vec3 {
     Vec3::new(r * c, r * s, z)
 }
 
+/// Positive on the horizon too, as Nori's: the sampler returns z = 0 at u.x = 0.
 #[inline]
 pub fn square_to_uniform_hemisphere_pdf(v: Vec3) -> f32 {
-    if v.z > 0.0 {
+    if v.z >= 0.0 {
         0.5 * INV_PI
     } else {
         0.0
@@ -218,6 +219,21 @@ mod tests {
             assert!((on_x - Vec2::new(r, 0.0)).length() < 1e-6, "{on_x}");
             assert!((on_y - Vec2::new(0.0, r)).length() < 1e-6, "{on_y}");
         }
+    }
+
+    /// The hemisphere samplers' edge u.x = 0: the uniform one returns the horizon, z = 0, a
+    /// direction its pdf must not call impossible.
+    #[test]
+    fn uniform_hemisphere_pdf_covers_the_horizon_it_samples() {
+        for uy in [0.0f32, 0.3, 0.9] {
+            let v = square_to_uniform_hemisphere(Vec2::new(0.0, uy));
+            assert_eq!(v.z, 0.0);
+            assert_eq!(square_to_uniform_hemisphere_pdf(v), 0.5 * INV_PI);
+        }
+        assert_eq!(
+            square_to_uniform_hemisphere_pdf(Vec3::new(1.0, 0.0, -1e-7)),
+            0.0
+        );
     }
 
     #[test]
