@@ -134,6 +134,32 @@ mod tests {
             }
         }
     }
+    /// `len`, `is_empty` and `bin` describe the table `sample` walks (the lane kernel
+    /// reads the bins directly): u in bin i picks i below the keep probability, else the
+    /// alias; bins of zero pmf are never kept.
+    #[test]
+    fn bins_describe_what_sample_picks() {
+        let pmf = [0.5f64, 0.0, 2.0, 1.0, 0.25, 3.0, 0.0];
+        let t = AliasTable::new(&pmf).unwrap();
+        assert_eq!(t.len(), pmf.len());
+        assert!(!t.is_empty());
+        let n = t.len() as f32;
+        let mut kept_somewhere = 0;
+        for i in 0..t.len() {
+            let (keep, alias) = t.bin(i);
+            assert!((0.0..=1.0).contains(&keep) && (alias as usize) < t.len());
+            assert!(pmf[i] > 0.0 || keep == 0.0, "bin {i}");
+            assert!(pmf[alias as usize] > 0.0 || keep == 1.0, "bin {i}");
+            for f in [0.001f32, 0.25, 0.5, 0.75, 0.999] {
+                let u = (i as f32 + f) / n;
+                let want = if f < keep { i } else { alias as usize };
+                assert_eq!(t.sample(u), want, "bin {i}, fraction {f}");
+            }
+            kept_somewhere += (keep > 0.0 && keep < 1.0) as usize;
+        }
+        assert!(kept_somewhere > 0, "the test needs bins that split");
+    }
+
     use crate::rng::Rng;
 
     #[test]

@@ -36,6 +36,24 @@ pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
 mod tests {
     use super::*;
 
+    /// Every n up to 64 has n distinct nodes in (-1, 1), in decreasing order, symmetric about
+    /// 0, with positive weights summing to 2: Newton from each cosine guess found its own root.
+    #[test]
+    fn nodes_are_distinct_decreasing_and_symmetric() {
+        for n in 1..=64usize {
+            let q = gauss_legendre(n);
+            for w in q.windows(2) {
+                assert!(w[0].0 > w[1].0 + 1e-6, "n = {n}: {:?}", w);
+            }
+            for i in 0..n {
+                assert!(q[i].0.abs() < 1.0 && q[i].1 > 0.0, "n = {n}");
+                assert!((q[i].0 + q[n - 1 - i].0).abs() < 1e-14, "n = {n}, node {i}");
+            }
+            let sum: f64 = q.iter().map(|p| p.1).sum();
+            assert!((sum - 2.0).abs() < 1e-13, "n = {n}: {sum}");
+        }
+    }
+
     /// Monomials up to degree 2n - 1 integrate exactly (to 1e-13); degree 2n does not (checked
     /// where its error is visible, n <= 5).
     #[test]

@@ -230,3 +230,105 @@ fn beckmann_slope_inversion_matches_bisection() {
     }
     eprintln!("slope inversion: worst {worst:.2} ulp of x or eps of u from the exact root");
 }
+
+/// Where z^4 underflows f32 (|m.z| below ~1e-11) Beckmann's D is 0, not 0 / 0, and GGX's is
+/// the finite limit it tends to; a normal in the plane has D = 0 for both.
+#[test]
+fn d_is_finite_where_z_to_the_fourth_underflows() {
+    for z in [1e-12f32, 1e-20, 1e-30] {
+        let m = Vec3::new(1.0, 0.5, z).normalize();
+        for d in DISTS {
+            let v = Microfacet::new(d, 0.3, 0.3).d(m);
+            assert!(v.is_finite() && v >= 0.0, "{d:?} at z = {z}: {v}");
+            if d == MicrofacetDistribution::Beckmann {
+                assert_eq!(v, 0.0, "Beckmann at z = {z}");
+            }
+        }
+    }
+    for d in DISTS {
+        assert_eq!(Microfacet::new(d, 0.3, 0.3).d(Vec3::X), 0.0);
+    }
+}
+
+/// One step of the slope inversion (`slope_step`) on C(x) = erfc(-x) + tan / sqrt(pi)
+/// exp(-x^2), with a target whose root r = 0.5 is known (tan(theta) = 1), checked rule by rule:
+/// - from r - 0.1 Halley's step lands within 3e-3 of r (Newton's would be 6e-2 off, a wrong
+///   second derivative 1.5e-2), inside the bracket, and has not converged;
+/// - from r + 1.2e-5 the step is below its bound 1e-5 (1 + |x|) = 1.5e-5 while |f| is far
+///   above 4 eps target and the bracket is wide: converged by the step alone, landing on r;
+/// - a bracket 0.8 of its bound 4e-6 (1 + |x|) wide that excludes the root: Halley's step
+///   leaves it, so the step bisects; converged by the bracket alone.
+#[test]
+fn slope_step_converges_by_each_rule() {
+    use std::f64::consts::PI as PI64;
+    let tan_t = 1.0f32;
+    let k = tan_t / SQRT_PI;
+    let r = 0.5f64;
+    let c = |x: f64| statrs::function::erf::erfc(-x) + (k as f64) * (-x * x).exp();
+    let target = c(r) as f32;
+    let (lo, hi) = (-9.0f32, 1.0 / tan_t);
+    assert!(((k as f64) - 1.0 / PI64.sqrt()).abs() < 1e-7);
+
+    let (next, lo1, hi1, done) = slope_step(0.4, lo, hi, target, tan_t, k);
+    assert!((next as f64 - r).abs() < 3e-3, "Halley from 0.4: {next}");
+    assert!(
+        (lo1, hi1) == (0.4, hi) && next > lo1 && next < hi1,
+        "{lo1} {hi1}"
+    );
+    assert!(!done, "a step of 0.1 is not convergence");
+
+    let x = (r + 1.2e-5) as f32;
+    let (next, _, hi1, done) = slope_step(x, lo, hi, target, tan_t, k);
+    assert_eq!(hi1, x, "C(x) > target moves the upper end");
+    assert!(done, "a step of 1.2e-5 converges at x = {x}");
+    assert!((next as f64 - r).abs() < 1e-6, "{next}");
+
+    let (lo2, hi2) = (0.2f32, 0.2 + 0.8 * 4e-6 * 1.2);
+    let (next, _, _, done) = slope_step(lo2, lo2, hi2, target, tan_t, k);
+    assert_eq!(next, 0.5 * (lo2 + hi2), "a step out of the bracket bisects");
+    assert!(done, "a bracket below its bound converges");
+}
+
+/// The full-distribution sampler's slope-space convention (module doc): slope (x, y) =
+/// r (alpha_u cos 2 pi u1, alpha_v sin 2 pi u1) and m = normalize(-x, -y, 1). The density
+/// is symmetric, so the chi-square cannot see a flipped sign; images sampled with a seed
+/// would change.
+#[test]
+fn full_sampler_follows_the_slope_convention() {
+    for d in DISTS {
+        let mf = Microfacet::new(d, 0.3, 0.6);
+        for (u0, u1) in [(0.5f32, 0.1f32), (0.2, 0.3), (0.7, 0.6), (0.4, 0.85)] {
+            let r = match d {
+                MicrofacetDistribution::Beckmann => (-(1.0 - u0 as f64).ln()).sqrt(),
+                MicrofacetDistribution::Ggx => (u0 as f64 / (1.0 - u0 as f64)).sqrt(),
+            };
+            let phi = std::f64::consts::TAU * u1 as f64;
+            let want = DVec3::new(-r * phi.cos() * 0.3, -r * phi.sin() * 0.6, 1.0).normalize();
+            let m = mf.sample_all(Vec2::new(u0, u1)).as_dvec3();
+            assert!(
+                (m - want).length() < 1e-6,
+                "{d:?} u ({u0}, {u1}): {m} vs {want}"
+            );
+        }
+    }
+}
+
+/// Heitz's GGX visible-normal sampler at normal incidence, in closed form: the disk point
+/// sqrt(u0) (cos 2 pi u1, sin 2 pi u1) lifted to the hemisphere and unstretched. (Its density
+/// is symmetric in the azimuth, so only this pins the sign of the second disk coordinate.)
+#[test]
+fn ggx_visible_sampler_at_normal_incidence_in_closed_form() {
+    let mf = Microfacet::new(MicrofacetDistribution::Ggx, 0.3, 0.6);
+    for (u0, u1) in [(0.5f32, 0.1f32), (0.2, 0.3), (0.7, 0.6), (0.4, 0.85)] {
+        let r = (u0 as f64).sqrt();
+        let phi = std::f64::consts::TAU * u1 as f64;
+        let want = DVec3::new(
+            0.3 * r * phi.cos(),
+            0.6 * r * phi.sin(),
+            (1.0 - r * r).sqrt(),
+        )
+        .normalize();
+        let m = mf.sample_visible(Vec3::Z, Vec2::new(u0, u1)).as_dvec3();
+        assert!((m - want).length() < 1e-6, "u ({u0}, {u1}): {m} vs {want}");
+    }
+}

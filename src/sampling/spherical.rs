@@ -218,6 +218,58 @@ mod tests {
         }
     }
 
+    /// Corner angles near 0 and pi: each branch of `angle_between` is the well-conditioned
+    /// one on its side (acos-like forms lose half the digits there).
+    #[test]
+    fn angle_between_is_accurate_near_zero_and_pi() {
+        for eps in [1e-3f64, 1e-6, 1e-9] {
+            let u = DVec3::X;
+            let near = DVec3::new(eps.cos(), eps.sin(), 0.0);
+            let opposite = DVec3::new(-eps.cos(), eps.sin(), 0.0);
+            let a = angle_between(u, near);
+            let b = angle_between(u, opposite);
+            assert!((a - eps).abs() < 1e-15, "{a} vs {eps}");
+            let want = std::f64::consts::PI - eps;
+            assert!((b - want).abs() < 1e-15, "{b} vs {want}");
+        }
+    }
+
+    /// The barycentrics of a point q of the triangle are found again from the ray towards it,
+    /// for triangles and points in general position; a ray parallel to the plane, one going
+    /// away from it, and one from a point in the plane have none.
+    #[test]
+    fn ray_plane_barycentrics_recover_the_point() {
+        let mut rng = Rng::new(8, 3);
+        let mut r3 = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 4.0 - 2.0;
+        for _ in 0..1000 {
+            let v = [r3(), r3(), r3()];
+            let p = r3();
+            let (b1, b2) = (0.7 * r3().x.abs() / 2.0, 0.3 * r3().y.abs() / 2.0);
+            let q = v[0] * (1.0 - b1 - b2) + v[1] * b1 + v[2] * b2;
+            let cross = (v[1] - v[0]).cross(v[2] - v[0]);
+            let (n, w) = (cross.normalize(), (q - p).normalize());
+            if n.dot(w).abs() < 0.05 || cross.length() < 0.5 {
+                continue;
+            }
+            let b = ray_plane_barycentrics(p, w, v).unwrap();
+            assert!(
+                (b - Vec2::new(b1, b2)).abs().max_element() < 2e-4,
+                "{b} vs {b1} {b2}"
+            );
+            assert!(
+                ray_plane_barycentrics(p, -w, v).is_none(),
+                "behind the point"
+            );
+        }
+        let v = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        assert!(ray_plane_barycentrics(Vec3::new(0.2, 0.2, 1.0), Vec3::X, v).is_none());
+        let in_plane = Vec3::new(0.2, 0.2, 0.0);
+        assert!(ray_plane_barycentrics(in_plane, Vec3::new(0.0, 0.6, 0.8), v).is_none());
+        // Points just outside are clamped onto the triangle.
+        let b = ray_plane_barycentrics(Vec3::new(1.0, 1.0, 1.0), -Vec3::Z, v).unwrap();
+        assert_eq!(b.x + b.y, 1.0);
+    }
+
     #[test]
     fn tiny_and_huge_triangles_fall_back() {
         let v = [

@@ -130,9 +130,10 @@ pub fn square_to_uniform_hemisphere(u: Vec2) -> Vec3 {
     Vec3::new(r * c, r * s, z)
 }
 
+/// Positive on the horizon too, as Nori's: the sampler returns z = 0 at u.x = 0.
 #[inline]
 pub fn square_to_uniform_hemisphere_pdf(v: Vec3) -> f32 {
-    if v.z > 0.0 {
+    if v.z >= 0.0 {
         0.5 * INV_PI
     } else {
         0.0
@@ -204,6 +205,35 @@ mod tests {
             assert_eq!((s.abs(), c), (want.0, want.1), "u={u}");
         }
         assert_eq!(sin_cos_turns(0.75), (-1.0, 0.0));
+    }
+
+    /// The concentric map on the square's axes (where one of the wedge ratio's terms is 0)
+    /// and at its centre, by hand: the axes map onto the disk's axes, the centre to 0.
+    #[test]
+    fn concentric_disk_on_the_axes() {
+        let d = |x: f32, y: f32| square_to_concentric_disk(Vec2::new(x, y));
+        assert_eq!(d(0.5, 0.5), Vec2::ZERO);
+        for (t, r) in [(0.9f32, 0.8f32), (0.1, -0.8), (1.0, 1.0)] {
+            let on_x = d(t, 0.5);
+            let on_y = d(0.5, t);
+            assert!((on_x - Vec2::new(r, 0.0)).length() < 1e-6, "{on_x}");
+            assert!((on_y - Vec2::new(0.0, r)).length() < 1e-6, "{on_y}");
+        }
+    }
+
+    /// The hemisphere samplers' edge u.x = 0: the uniform one returns the horizon, z = 0, a
+    /// direction its pdf must not call impossible.
+    #[test]
+    fn uniform_hemisphere_pdf_covers_the_horizon_it_samples() {
+        for uy in [0.0f32, 0.3, 0.9] {
+            let v = square_to_uniform_hemisphere(Vec2::new(0.0, uy));
+            assert_eq!(v.z, 0.0);
+            assert_eq!(square_to_uniform_hemisphere_pdf(v), 0.5 * INV_PI);
+        }
+        assert_eq!(
+            square_to_uniform_hemisphere_pdf(Vec3::new(1.0, 0.0, -1e-7)),
+            0.0
+        );
     }
 
     #[test]
