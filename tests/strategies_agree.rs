@@ -20,6 +20,7 @@ fn render_with(scene: &Scene, s: Strategy, spp: u32, seed: u64) -> RenderOutput 
             first_sample: 0,
             threads: None,
             progress: false,
+            sampling: Default::default(),
         },
     )
 }
