@@ -57,7 +57,7 @@ pub(crate) fn measure(
     Row {
         context: context.to_string(),
         case: String::new(),
-        strategy: job.strategy.label(),
+        strategy: job.method.label(),
         name: job.name.clone(),
         kind: job.kind.to_string(),
         budget_s: job.budget,

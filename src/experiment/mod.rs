@@ -8,6 +8,7 @@ pub mod chunks;
 pub mod figures;
 pub mod leftout;
 mod measure;
+pub mod method;
 pub mod plan;
 pub mod probe;
 pub mod resolve;

@@ -1,9 +1,9 @@
 //! What a sweep still has to render (resuming from `results.csv`), and where the images the
 //! figures need are kept.
 
+use super::method::Method;
 use super::results::{Results, Row, SWEEP};
 use crate::film::{self, Image};
-use crate::integrator::Strategy;
 use std::path::{Path, PathBuf};
 
 pub fn image_path(dir: &Path, label: &str, tag: &str, seed: u64) -> PathBuf {
@@ -27,7 +27,7 @@ pub fn time_tag(budget: f64) -> String {
 /// One render to do.
 pub(crate) struct Job {
     pub(crate) name: String,
-    pub(crate) strategy: Strategy,
+    pub(crate) method: Method,
     pub(crate) kind: &'static str,
     pub(crate) budget: f64,
     pub(crate) spp: u32,
@@ -64,7 +64,7 @@ pub(crate) struct Sweep<'a> {
 
 /// The sweep's renders still to do: rows missing from `results`, and rows whose image the
 /// figures need but which is missing (seeds give the same image again, so the row is redone).
-pub(crate) fn plan_sweep(results: &Results, kept: &[(String, Strategy)], sw: &Sweep) -> Vec<Job> {
+pub(crate) fn plan_sweep(results: &Results, kept: &[(String, Method)], sw: &Sweep) -> Vec<Job> {
     let mut jobs = Vec::new();
     for seed in 0..sw.seeds as u64 {
         for &spp in sw.spp {
@@ -75,7 +75,7 @@ pub(crate) fn plan_sweep(results: &Results, kept: &[(String, Strategy)], sw: &Sw
                 if !done || !has_image(&image) {
                     jobs.push(Job {
                         name: name.clone(),
-                        strategy: *s,
+                        method: *s,
                         kind: SWEEP,
                         budget: 0.0,
                         spp,
@@ -109,6 +109,7 @@ pub fn load_image(p: &Path) -> Result<(Image, Image), String> {
 mod tests {
     use super::*;
     use crate::experiment::results::test_row;
+    use crate::integrator::Strategy;
     use crate::scene::desc::{Heuristic, StrategyKind};
 
     #[test]
@@ -123,6 +124,10 @@ mod tests {
             selection: crate::emitter::EmitterSelection::Uniform,
             light_sampling: crate::emitter::LightSampling::Area,
             hide_emitters: false,
+        };
+        let s = Method {
+            strategy: s,
+            sampler: Default::default(),
         };
         let label = s.label();
         let kept = vec![("light".to_string(), s)];

@@ -4,6 +4,7 @@
 use super::cache::{self, Fnv, KeyInputs, Reference, ReferenceRequest};
 use super::leftout::{leave_out, Omission, SceneTraits};
 use super::measure::measure;
+use super::method::{cross, Method};
 use super::plan::{
     has_image, image_path, plan_sweep, rate, same_run, time_tag, variance_path, Job, Sweep,
 };
@@ -55,14 +56,14 @@ struct Ctx<'a> {
 fn execute(ctx: &Ctx, job: &Job) -> Result<Row, String> {
     let out = render(
         ctx.scene,
-        job.strategy,
+        job.method.strategy,
         &RenderSettings {
             spp: job.spp,
             seed: job.seed,
             first_sample: 0,
             threads: ctx.threads,
             progress: false,
-            sampling: Default::default(),
+            sampling: job.method.sampler.sampling(),
         },
     );
     if let Some(p) = &job.image {
@@ -138,11 +139,12 @@ fn rendered_reference(
     Ok((key, reference))
 }
 
-/// Strategies with their legend names.
-type Named = Vec<(String, Strategy)>;
+/// Columns (strategy and sampler) with their legend names.
+type Named = Vec<(String, Method)>;
 
 /// The experiment's strategies on the scene's settings `base`, without those that are the
-/// same estimator on this scene or cannot see its light (each said on stderr).
+/// same estimator on this scene or cannot see its light (each said on stderr), crossed with
+/// its samplers.
 fn strategies(
     exp: &Resolved,
     base: Strategy,
@@ -161,14 +163,14 @@ fn strategies(
             exp.name, o.name, o.label, o.reason
         );
     }
-    Ok((kept, omitted))
+    Ok((cross(&kept, &exp.exp.samplers), omitted))
 }
 
 /// The equal-time runs still to do: each budget, seed and strategy without its row and
 /// image, at the spp the sweep's measured rate gives the budget.
 fn equal_time_jobs(
     et: &EqualTimeSpec,
-    kept: &[(String, Strategy)],
+    kept: &[(String, Method)],
     results: &Results,
     dir: &Path,
     pixels: u64,
@@ -195,7 +197,7 @@ fn equal_time_jobs(
                 };
                 timed.push(Job {
                     name: name.clone(),
-                    strategy: *s,
+                    method: *s,
                     kind: EQUAL_TIME,
                     budget,
                     spp,

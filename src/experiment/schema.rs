@@ -6,6 +6,7 @@
 //! A file names one `scene`, or several `[[case]]`s (see `cases.rs`).
 
 use super::cases::{AccumulationSpec, Case, CaseSpec, ClosedForm, InvalidSpec, ProbeSpec};
+use super::method::SamplerSpec;
 use crate::emitter::{EmitterSelection, LightSampling};
 use crate::integrator::StrategyOverrides;
 use crate::scene::desc::{Heuristic, StrategyKind};
@@ -36,6 +37,10 @@ pub struct Experiment {
     pub seeds: u32,
     #[serde(rename = "strategy")]
     pub strategies: Vec<StrategySpec>,
+    /// Samplers every strategy is run with (`"sobol"`, `"sobol:padded"`, ...): the
+    /// strategies crossed with these are the experiment's columns. Default: independent.
+    #[serde(default = "default_samplers")]
+    pub samplers: Vec<SamplerSpec>,
     #[serde(default)]
     pub reference: ReferenceSpec,
     #[serde(default)]
@@ -51,6 +56,10 @@ pub struct Experiment {
     /// Overrides applied by `--quick` (tests, smoke runs).
     #[serde(default)]
     pub quick: Option<QuickSpec>,
+}
+
+fn default_samplers() -> Vec<SamplerSpec> {
+    vec![SamplerSpec::default()]
 }
 
 fn default_seeds() -> u32 {

@@ -93,6 +93,26 @@ fn rejects_typos_and_bad_values() {
     let crop = EXAMPLE.replace("width = 0.25", "width = 1.25");
     let e = resolve(parse(&crop, &file()).unwrap(), &file(), false).unwrap_err();
     assert!(e.contains("crop"), "{e}");
+    // The samplers axis: names, duplicates, an empty list.
+    let with = |list: &str| EXAMPLE.replace("seeds = 2", &format!("seeds = 2\nsamplers = {list}"));
+    let ok = parse(&with(r#"["sobol", "stratified"]"#), &file()).unwrap();
+    assert_eq!(ok.samplers.len(), 2);
+    assert_eq!(
+        parse(EXAMPLE, &file()).unwrap().samplers,
+        [Default::default()]
+    );
+    let e = parse(&with(r#"["sobol", "halton"]"#), &file()).unwrap_err();
+    assert!(e.contains("unknown sampler 'halton'"), "{e}");
+    for (list, says) in [
+        (
+            r#"["sobol", "sobol:joint"]"#,
+            "sampler 'sobol' is listed twice",
+        ),
+        ("[]", "at least one sampler"),
+    ] {
+        let e = resolve(parse(&with(list), &file()).unwrap(), &file(), false).unwrap_err();
+        assert!(e.contains(says), "{list}: {e}");
+    }
 }
 
 const PROBE: &str = r#"
@@ -182,6 +202,14 @@ fn probe_mode_rejects_missing_references_and_image_keys_naming_the_key() {
         "refrence = { value = 0.25 }",
     );
     assert!(e.contains("refrence"), "unknown keys in a case: {e}");
+    let e = err(
+        "seeds = 1",
+        "seeds = 1\n    samplers = [\"independent\", \"sobol\"]",
+    );
+    assert!(
+        e.contains("probe mode") && e.contains("independent sampler only ('sobol' listed)"),
+        "{e}"
+    );
     let e = err("samples = 256", "samples = 100");
     assert!(
         e.contains("probe.samples = 100 leaves fewer than 32 batches"),

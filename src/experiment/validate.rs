@@ -100,6 +100,17 @@ pub(crate) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
     if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
         return fail(format!("strategy name '{}' is used twice", w[0]));
     }
+    if exp.samplers.is_empty() {
+        return fail(
+            "samplers = []: at least one sampler is needed (the default is [\"independent\"])"
+                .into(),
+        );
+    }
+    let mut samplers = exp.samplers.clone();
+    samplers.sort_by_key(|s| s.to_string());
+    if let Some(w) = samplers.windows(2).find(|w| w[0] == w[1]) {
+        return fail(format!("sampler '{}' is listed twice", w[0]));
+    }
     if let Some(et) = &exp.equal_time {
         if let Some(s) = et
             .seconds
@@ -186,6 +197,18 @@ pub(crate) fn validate_cases(exp: &Experiment, cases: &[Case], file: &Path) -> R
     };
     if r.spp.is_some() {
         return fail("reference.spp: probe mode measures against closed-form values only".into());
+    }
+    // A probe's batches are consecutive samples of one pixel: with a sequence sampler they
+    // are not independent randomisations, so its batch statistics would not hold.
+    if let Some(s) = exp
+        .samplers
+        .iter()
+        .find(|s| s.kind != crate::sampler::SamplerKind::Independent)
+    {
+        return fail(format!(
+            "samplers: probe mode draws its batches from one pixel's stream and takes the \
+             independent sampler only ('{s}' listed); compare samplers in an image sweep"
+        ));
     }
     let image_only = [
         ("[equal_time]", exp.equal_time.is_some()),

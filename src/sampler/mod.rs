@@ -82,6 +82,12 @@ impl SamplerKind {
     pub fn needs_sample_count(self) -> bool {
         self == SamplerKind::Stratified
     }
+
+    /// Whether the dimension allocation (`DimAlloc`) changes the sampler's points: the
+    /// independent sampler has no sets, the stratified one is always padded.
+    pub fn allocates_dims(self) -> bool {
+        matches!(self, SamplerKind::Sobol | SamplerKind::SobolXor)
+    }
 }
 
 /// How a sample's groups of numbers take their dimensions.
