@@ -318,6 +318,13 @@ strategy = "bsdf"
     }
     let index = std::fs::read_to_string(out.join("furnace/index.md")).unwrap();
     assert!(index.contains("light, sobol:padded"), "{index}");
+    // The rates table: a bootstrap interval over the 2 seeds and the local slope 4 -> 16.
+    let rates = &index[index.find("## Convergence rates").expect("rates table")..];
+    let row = rates
+        .lines()
+        .find(|l| l.starts_with("| light, sobol |"))
+        .expect("a row per column");
+    assert!(row.contains("4→16: ") && row.matches('[').count() == 1, "{row}");
     let again =
         run(directlab().args(["run", exp.to_str().unwrap(), "--out", out.to_str().unwrap()]));
     assert!(again.status.success());

@@ -3,6 +3,7 @@
 
 use super::results::Row;
 use super::schema::ErrorMetric;
+use crate::stats::slope::{bootstrap_slope, local_slopes, SeedErrors, BOOTSTRAP_DRAWS};
 use statrs::distribution::{ContinuousCDF, Normal};
 
 /// The chosen error of a row, corrected for the reference's noise.
@@ -64,6 +65,42 @@ pub struct Series {
     pub points: Vec<Point>,
     /// Least-squares slope of log(error) over log(spp), from points clear of the noise floor.
     pub slope: Option<f64>,
+    /// Its 95 % bootstrap interval over seeds (`stats::slope::bootstrap_slope`), from the
+    /// seeds present at every fitted spp; None with fewer than two.
+    pub slope_ci: Option<(f64, f64)>,
+}
+
+impl Series {
+    /// Slopes between consecutive spp of the curve.
+    pub fn local_slopes(&self) -> Vec<(u32, u32, f64)> {
+        let pts: Vec<(u32, f64)> = self.points.iter().map(|p| (p.spp, p.error)).collect();
+        local_slopes(&pts)
+    }
+}
+
+/// Each fitted spp's errors per seed, over the seeds present at all of them.
+fn seed_errors(rows: &[Row], label: &str, spps: &[u32], m: ErrorMetric) -> Vec<SeedErrors> {
+    let at = |spp: u32, seed: u64| {
+        rows.iter()
+            .find(|r| r.is_sweep() && r.strategy == label && r.spp == spp && r.seed == seed)
+    };
+    let mut seeds: Vec<u64> = rows
+        .iter()
+        .filter(|r| r.is_sweep() && r.strategy == label)
+        .map(|r| r.seed)
+        .collect();
+    seeds.sort();
+    seeds.dedup();
+    seeds.retain(|&s| spps.iter().all(|&spp| at(spp, s).is_some()));
+    spps.iter()
+        .map(|&spp| SeedErrors {
+            spp,
+            errors: seeds
+                .iter()
+                .filter_map(|&s| at(spp, s).map(|r| error_of(r, m)))
+                .collect(),
+        })
+        .collect()
 }
 
 /// Sweep rows grouped per strategy (in `order`, a list of labels) and spp.
@@ -98,33 +135,27 @@ pub fn series(rows: &[Row], order: &[(String, String)], m: ErrorMetric) -> Vec<S
                     }
                 })
                 .collect();
-            let fit: Vec<(f64, f64)> = points
+            let fitted: Vec<&Point> = points
                 .iter()
                 .filter(|p| !p.near_floor && p.error > 0.0)
+                .collect();
+            let fit: Vec<(f64, f64)> = fitted
+                .iter()
                 .map(|p| ((p.spp as f64).ln(), p.error.ln()))
                 .collect();
+            let fit_spps: Vec<u32> = fitted.iter().map(|p| p.spp).collect();
             Series {
                 label: label.clone(),
                 name: name.clone(),
                 slope: fit_slope(&fit),
+                slope_ci: bootstrap_slope(&seed_errors(rows, label, &fit_spps, m), BOOTSTRAP_DRAWS),
                 points,
             }
         })
         .collect()
 }
 
-/// Ordinary least-squares slope; None with fewer than two distinct x.
-pub fn fit_slope(xy: &[(f64, f64)]) -> Option<f64> {
-    let n = xy.len() as f64;
-    if xy.len() < 2 {
-        return None;
-    }
-    let mx = xy.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = xy.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxx: f64 = xy.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = xy.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    (sxx > 0.0).then(|| sxy / sxx)
-}
+pub use crate::stats::slope::fit_slope;
 
 /// A strategy's image mean per channel, pooled over seeds at one spp, with its variance.
 #[derive(Clone, Debug)]
@@ -216,19 +247,6 @@ pub fn mean_difference(a: &PooledMean, b: &PooledMean, alpha_per_test: f64) -> V
 mod tests {
     use super::*;
     use crate::experiment::results::test_row;
-
-    #[test]
-    fn slope_of_exact_power_laws() {
-        let pts: Vec<(f64, f64)> = [1.0f64, 2.0, 4.0, 8.0]
-            .iter()
-            .map(|&n| (n.ln(), (3.0 / n).ln()))
-            .collect();
-        assert!((fit_slope(&pts).unwrap() + 1.0).abs() < 1e-12);
-        let half: Vec<(f64, f64)> = pts.iter().map(|p| (p.0, 0.5 * p.1)).collect();
-        assert!((fit_slope(&half).unwrap() + 0.5).abs() < 1e-12);
-        assert!(fit_slope(&pts[..1]).is_none());
-        assert!(fit_slope(&[(1.0, 1.0), (1.0, 2.0)]).is_none());
-    }
 
     #[test]
     fn series_average_seeds_and_skip_floor_points_in_the_fit() {

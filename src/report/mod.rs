@@ -135,6 +135,7 @@ pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> R
     settings(&mut md, o);
     left_out(&mut md, o);
     tables::error_table(&mut md, o, series);
+    tables::rate_table(&mut md, o, series);
     tables::diagnostics(&mut md, o, series);
     tables::equal_time_table(&mut md, o);
     means::means(&mut md, o);

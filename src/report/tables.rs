@@ -52,6 +52,46 @@ pub(super) fn error_table(md: &mut String, o: &Outcome, series: &[Series]) {
     md.push('\n');
 }
 
+/// Convergence rates: each curve's slope with its bootstrap interval over seeds, and the
+/// local slopes between consecutive spp, with why the errors are taken across seeds.
+pub(super) fn rate_table(md: &mut String, o: &Outcome, series: &[Series]) {
+    let seeds = o.exp.exp.seeds;
+    let _ = writeln!(
+        md,
+        "## Convergence rates\n\nEach error is the mean over {seeds} seeds of one seed's error against the \
+         reference: every seed is an independent randomisation of the sampler, so this holds for \
+         correlated samples (stratified, Sobol') as well as independent ones. The error a run's own \
+         per-pixel variance predicts assumes independent samples and is wrong for the others: \
+         'measured / predicted' below is that diagnostic (about 1 for independent samples, under 1 \
+         where a sampler's samples are negatively correlated). Intervals: 95 % percentile bootstrap \
+         over seeds ({} draws; a seed is resampled with all its spp), which needs at least 2 seeds \
+         and is only as good as the seeds are many (32 or more for a rate).\n\n\
+         | strategy | slope | 95 % interval | local slopes (spp: slope) |\n|---|---|---|---|",
+        crate::stats::slope::BOOTSTRAP_DRAWS
+    );
+    for s in series {
+        let local: Vec<String> = s
+            .local_slopes()
+            .iter()
+            .map(|(a, b, k)| format!("{a}→{b}: {k:.2}"))
+            .collect();
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} |",
+            s.name,
+            s.slope.map_or("-".into(), |k| format!("{k:.2}")),
+            s.slope_ci
+                .map_or("-".into(), |(lo, hi)| format!("[{lo:.2}, {hi:.2}]")),
+            if local.is_empty() {
+                "-".into()
+            } else {
+                local.join(", ")
+            }
+        );
+    }
+    md.push('\n');
+}
+
 /// Reads each curve: does it fall as 1/N, and do run and reference agree pixel by pixel? The
 /// verdicts are rules of thumb, stated as such in the report.
 pub(super) fn diagnostics(md: &mut String, o: &Outcome, series: &[Series]) {
