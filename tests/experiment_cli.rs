@@ -324,7 +324,10 @@ strategy = "bsdf"
         .lines()
         .find(|l| l.starts_with("| light, sobol |"))
         .expect("a row per column");
-    assert!(row.contains("4→16: ") && row.matches('[').count() == 1, "{row}");
+    assert!(
+        row.contains("4→16: ") && row.matches('[').count() == 1,
+        "{row}"
+    );
     let again =
         run(directlab().args(["run", exp.to_str().unwrap(), "--out", out.to_str().unwrap()]));
     assert!(again.status.success());

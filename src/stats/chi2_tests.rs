@@ -426,3 +426,30 @@ fn p_values_are_uniform_for_a_correct_sampler() {
         "the KS check cannot see a wrong dof: D = {d_wrong}"
     );
 }
+
+/// A pdf that is negative or NaN somewhere fails with the count of such integration nodes,
+/// each kind on its own (a uniform sampler, so nothing else can fail first), and those
+/// nodes add nothing to the cells.
+#[test]
+fn negative_or_nan_pdf_values_fail_with_their_count() {
+    let uniform = |g: &mut Rng| Some(Vec2::new(g.next_f32(), g.next_f32()));
+    for bad in [-1.0, f64::NAN] {
+        let pdf = move |p: Vec2| if p.x > 0.9 { bad } else { 1.0 };
+        let r = chi2_test(&square(), uniform, pdf, &cfg(0.01));
+        assert!(!r.passed(), "{bad}: {}", r.reason);
+        let why = &r.reason;
+        let count: u64 = why
+            .strip_prefix("pdf returned NaN or a negative value at ")
+            .and_then(|s| s.strip_suffix(" integration nodes"))
+            .unwrap_or_else(|| panic!("{why}"))
+            .parse()
+            .unwrap();
+        assert!(count > 0, "{why}");
+        let (grid, n) = cell_integrals_seen(&square(), pdf, &Integration::default(), None);
+        assert!(n > 0, "{bad}");
+        assert!(grid.data.iter().all(|x| *x >= 0.0 && x.is_finite()));
+        // Columns past x = 0.9 lose their mass: the total is about 0.9.
+        let total: f64 = grid.data.iter().sum();
+        assert!((total - 0.9).abs() < 0.02, "{total}");
+    }
+}
