@@ -57,6 +57,7 @@ fn bench_writes_every_section() {
         "machine: ",
         "cbox.xml: 16x16",
         "scene loading as the emitter count grows",
+        "x the independent sampler's time per sample",
     ] {
         assert!(
             stdout.contains(printed),
@@ -138,4 +139,8 @@ fn check_rows(out: &std::path::Path) {
     assert_eq!(sections["load_build"], 1, "{sections:?}");
     // The CPU the numbers were measured on, named.
     assert_eq!(sections["machine"], 1, "{sections:?}");
+    // Every sampler's speed and its slowdown against the independent one (whose own is 1).
+    let samplers = directlab::sampler::SamplerKind::ALL.len();
+    assert_eq!(sections["sampler_throughput"], samplers, "{sections:?}");
+    assert_eq!(sections["sampler_slowdown"], samplers, "{sections:?}");
 }

@@ -1,7 +1,7 @@
 //! `directlab bench`: speed goals as measured numbers (printed and written to
 //! `reports/bench/bench.csv`), never timed tests. Sections, each a function that prints and
 //! adds its rows: render throughput per scene, strategy and thread count with the machine's
-//! own scaling (`throughput`, `copies`); the ray-tracing limit for the same ray mix and the
+//! own scaling (`throughput`, `copies`), and per sampler (`samplers`); the ray-tracing limit for the same ray mix and the
 //! share of render time spent outside traversal, on one thread and on the most threads
 //! (`ray_limit_section` here, measured by `raylimit`); per-sample cost as the triangle and
 //! emitter counts grow (`sweeps`, over the scenes of `scaling`); scene loading as the emitter
@@ -10,6 +10,7 @@
 mod copies;
 mod load;
 mod raylimit;
+mod samplers;
 pub(crate) mod scaling;
 mod sweeps;
 mod throughput;
@@ -160,6 +161,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         // `res` sets the size of scenes that declare it; the others keep their own.
         println!("  {name}: {}x{}", scene.camera.width, scene.camera.height);
         throughput::section(&scene, &name, a, &mut rows);
+        samplers::section(&scene, &name, a, max_threads, &mut rows);
         ray_limit_section(&scene, &name, a, max_threads, &mut rows);
     }
     sweeps::section(a, max_threads, &mut rows)?;

@@ -4,6 +4,7 @@
 use super::least;
 use crate::integrator::Strategy;
 use crate::render::{render, RenderSettings};
+use crate::sampler::{SamplerKind, Sampling};
 use crate::scene::Scene;
 
 /// Camera samples per second of `spp` samples per pixel, best of `repeat`.
@@ -55,14 +56,44 @@ pub fn throughputs(
     })
 }
 
+/// Render throughput of `scene` with one strategy and each sampler, timed in turns as
+/// `throughputs` (a row per sampler, a column per thread count).
+pub fn sampler_throughputs(
+    scene: &Scene,
+    strategy: Strategy,
+    samplers: &[SamplerKind],
+    spp: u32,
+    threads: &[usize],
+    repeat: u32,
+) -> Vec<Vec<Timed>> {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let samples = w as f64 * h as f64 * spp as f64;
+    best_of_turns(samplers, threads, repeat, samples, |kind, t| {
+        let settings = RenderSettings {
+            spp,
+            seed: 1,
+            first_sample: 0,
+            threads: Some(t),
+            progress: false,
+            sampling: Sampling {
+                kind,
+                ..Default::default()
+            },
+        };
+        let out = render(scene, strategy, &settings);
+        (out.seconds, out.busy_seconds)
+    })
+}
+
 /// `throughputs`' schedule and bookkeeping around `time`, which renders `samples` camera
-/// samples with a strategy and thread count and returns (seconds, busy worker seconds).
-fn best_of_turns(
-    strategies: &[Strategy],
+/// samples with one configuration (a strategy, a sampler) and a thread count and returns
+/// (seconds, busy worker seconds).
+fn best_of_turns<T: Copy>(
+    strategies: &[T],
     threads: &[usize],
     repeat: u32,
     samples: f64,
-    mut time: impl FnMut(Strategy, usize) -> (f64, f64),
+    mut time: impl FnMut(T, usize) -> (f64, f64),
 ) -> Vec<Vec<Timed>> {
     let mut best: Vec<Vec<Option<Timed>>> = vec![vec![None; threads.len()]; strategies.len()];
     let mut runs = vec![vec![Vec::new(); threads.len()]; strategies.len()];
