@@ -19,6 +19,12 @@ pub trait PointSet: Copy + std::fmt::Debug + 'static {
     /// Dimensions `dim .. dim + k` (k from 1 to 4) of sample `index`, drawn together as one
     /// set; entries past k are unspecified. Each value lies in [0, 1).
     fn draw(pixel: &Self::Pixel, index: u64, dim: u32, k: usize) -> [f32; 4];
+    /// `draw` of samples `s0 .. s0 + LANES` at one dimension: a point set overrides it to
+    /// share per-group work (a seed's hash) between the lanes.
+    #[inline(always)]
+    fn draw_lanes(pixel: &Self::Pixel, s0: u64, dim: u32, k: usize) -> [[f32; 4]; LANES] {
+        std::array::from_fn(|l| Self::draw(pixel, s0 + l as u64, dim, k))
+    }
 }
 
 /// A pixel's shared state and whether its groups are drawn jointly.
@@ -113,6 +119,41 @@ pub struct PureLanes<P: PointSet> {
 }
 
 impl<P: PointSet> PureLanes<P> {
+    /// The next group of every lane, `N` values each: when every lane is at the same
+    /// dimension (they part only where the scalar path continued one), drawn a group at a
+    /// time across the lanes; otherwise lane by lane. The same values either way.
+    #[inline(always)]
+    fn group<const N: usize>(&mut self, parts: &[usize]) -> [[f32; LANES]; N] {
+        let d = self.dim[0];
+        if self.dim.iter().any(|&x| x != d) {
+            return self.each(|s| s.group(parts));
+        }
+        let mut out = [[0.0; LANES]; N];
+        let mut put = |at: usize, n: usize, v: [[f32; 4]; LANES]| {
+            for (l, v) in v.iter().enumerate() {
+                for j in 0..n {
+                    out[at + j][l] = v[j];
+                }
+            }
+        };
+        let k: usize = parts.iter().sum();
+        if self.pixel.joint {
+            put(0, k, P::draw_lanes(&self.pixel.inner, self.s0, d, k));
+        } else {
+            let mut at = 0;
+            for &n in parts {
+                put(
+                    at,
+                    n,
+                    P::draw_lanes(&self.pixel.inner, self.s0, d + at as u32, n),
+                );
+                at += n;
+            }
+        }
+        self.dim = [d + k as u32; LANES];
+        out
+    }
+
     #[inline(always)]
     fn each<const N: usize>(
         &mut self,
@@ -153,17 +194,17 @@ impl<P: PointSet> SamplerLanes for PureLanes<P> {
 
     #[inline(always)]
     fn film(&mut self) -> [[f32; LANES]; 2] {
-        self.each(|s| s.group(&[2]))
+        self.group(&[2])
     }
 
     #[inline(always)]
     fn light(&mut self) -> [[f32; LANES]; 4] {
-        self.each(|s| s.group(&[1, 1, 2]))
+        self.group(&[1, 1, 2])
     }
 
     #[inline(always)]
     fn bsdf(&mut self) -> [[f32; LANES]; 3] {
-        self.each(|s| s.group(&[1, 2]))
+        self.group(&[1, 2])
     }
 
     #[inline(always)]
