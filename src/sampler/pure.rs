@@ -19,12 +19,25 @@ pub trait PointSet: Copy + std::fmt::Debug + 'static {
     /// Dimensions `dim .. dim + k` (k from 1 to 4) of sample `index`, drawn together as one
     /// set; entries past k are unspecified. Each value lies in [0, 1).
     fn draw(pixel: &Self::Pixel, index: u64, dim: u32, k: usize) -> [f32; 4];
-    /// `draw` of samples `s0 .. s0 + LANES` at one dimension: a point set overrides it to
-    /// share per-group work (a seed's hash) between the lanes.
+    /// `draw` of samples `s0 .. s0 + LANES` at one dimension, by dimension then lane: a
+    /// point set overrides it to share per-group work (a seed's hash) between the lanes and
+    /// to compute them side by side.
     #[inline(always)]
-    fn draw_lanes(pixel: &Self::Pixel, s0: u64, dim: u32, k: usize) -> [[f32; 4]; LANES] {
-        std::array::from_fn(|l| Self::draw(pixel, s0 + l as u64, dim, k))
+    fn draw_lanes(pixel: &Self::Pixel, s0: u64, dim: u32, k: usize) -> [[f32; LANES]; 4] {
+        by_dimension(|l| Self::draw(pixel, s0 + l as u64, dim, k))
     }
+}
+
+/// Eight lanes' groups, each `lane(l)`, rearranged dimension by dimension.
+#[inline(always)]
+pub(crate) fn by_dimension(mut lane: impl FnMut(usize) -> [f32; 4]) -> [[f32; LANES]; 4] {
+    let mut out = [[0.0; LANES]; 4];
+    for l in 0..LANES {
+        for (o, v) in out.iter_mut().zip(lane(l)) {
+            o[l] = v;
+        }
+    }
+    out
 }
 
 /// A pixel's shared state and whether its groups are drawn jointly.
@@ -129,12 +142,8 @@ impl<P: PointSet> PureLanes<P> {
             return self.each(|s| s.group(parts));
         }
         let mut out = [[0.0; LANES]; N];
-        let mut put = |at: usize, n: usize, v: [[f32; 4]; LANES]| {
-            for (l, v) in v.iter().enumerate() {
-                for j in 0..n {
-                    out[at + j][l] = v[j];
-                }
-            }
+        let mut put = |at: usize, n: usize, v: [[f32; LANES]; 4]| {
+            out[at..at + n].copy_from_slice(&v[..n]);
         };
         let k: usize = parts.iter().sum();
         if self.pixel.joint {

@@ -17,7 +17,7 @@
 //! to 65,536 samples per pixel see one Sobol' sequence; longer ones (references) are
 //! averages of independent RQMC estimates, which converge at least at the Monte Carlo rate.
 
-use super::pure::{PointSet, PureLanes};
+use super::pure::{by_dimension, PointSet, PureLanes};
 use super::SamplerConfig;
 use crate::rng::LANES;
 use crate::rng::{mix64, Rng};
@@ -134,16 +134,40 @@ impl<const OWEN: bool> PointSet for Sobol<OWEN> {
     }
 
     /// Eight consecutive samples of one group share its randomisation unless they straddle
-    /// a block: the seed is hashed once, not per lane.
+    /// a block: the seed is hashed once, not per lane, and the lanes are computed side by
+    /// side (`Randomisation::point`'s steps, lane-major).
     #[inline(always)]
-    fn draw_lanes(pixel: &u64, s0: u64, dim: u32, k: usize) -> [[f32; 4]; LANES] {
+    fn draw_lanes(pixel: &u64, s0: u64, dim: u32, k: usize) -> [[f32; LANES]; 4] {
         let block = s0 / BLOCK;
         if (s0 + LANES as u64 - 1) / BLOCK != block {
-            return std::array::from_fn(|l| Self::draw(pixel, s0 + l as u64, dim, k));
+            return by_dimension(|l| Self::draw(pixel, s0 + l as u64, dim, k));
         }
         let r = Randomisation::new::<OWEN>(seed_of(*pixel, dim, block));
         let (t, i0) = (tables(), (s0 % BLOCK) as u32);
-        std::array::from_fn(|l| r.point::<OWEN>(t, i0 + l as u32))
+        let mut v = [[0u32; LANES]; 4];
+        for l in 0..LANES {
+            let rev = (i0 + l as u32).reverse_bits();
+            let p = t.point_rev(if OWEN {
+                owen_scramble_rev(rev, r.shuffle)
+            } else {
+                rev
+            });
+            for (v, p) in v.iter_mut().zip(p) {
+                v[l] = p;
+            }
+        }
+        let mut out = [[0.0; LANES]; 4];
+        for j in 0..4 {
+            for l in 0..LANES {
+                let x = if OWEN {
+                    owen_scramble_rev(v[j][l], r.mask[j]).reverse_bits()
+                } else {
+                    v[j][l].reverse_bits() ^ r.mask[j]
+                };
+                out[j][l] = u32_to_f32_norm(x);
+            }
+        }
+        out
     }
 }
 
@@ -250,16 +274,14 @@ mod tests {
             let lanes = Sobol::<true>::draw_lanes(&7, s0, 5, 4);
             let xor = Sobol::<false>::draw_lanes(&7, s0, 5, 4);
             for l in 0..LANES {
-                assert_eq!(
-                    lanes[l],
+                let (a, b) = (
                     Sobol::<true>::draw(&7, s0 + l as u64, 5, 4),
-                    "{s0} {l}"
-                );
-                assert_eq!(
-                    xor[l],
                     Sobol::<false>::draw(&7, s0 + l as u64, 5, 4),
-                    "{s0} {l}"
                 );
+                for j in 0..4 {
+                    assert_eq!(lanes[j][l], a[j], "{s0} {l}");
+                    assert_eq!(xor[j][l], b[j], "{s0} {l}");
+                }
             }
         }
     }
