@@ -42,3 +42,7 @@ pub fn run_and_report(exp: super::Resolved, opts: &RunOptions) -> Result<(), Str
     );
     Ok(())
 }
+
+#[cfg(test)]
+#[path = "sampler_bias_tests.rs"]
+mod sampler_bias_tests;
