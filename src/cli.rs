@@ -24,7 +24,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Run experiments (sweeps against a cached reference) and write their reports.
     Run(RunArgs),
-    /// Run the study's figures (experiments fig1, fig2, fig3) and write their reports.
+    /// Run the study's figures (experiments fig1, fig2, fig3) and the samplers' (fig4), and
+    /// write their reports.
     Reproduce(ReproduceArgs),
     /// Measure render throughput per strategy and thread count.
     Bench(crate::bench::BenchArgs),
@@ -131,7 +132,7 @@ fn cmd_extreme(a: &ExtremeArgs) -> Result<(), String> {
 
 fn cmd_reproduce(a: &ReproduceArgs) -> Result<(), String> {
     let dir = crate::experiment::experiments_dir()?;
-    let files: Vec<PathBuf> = ["fig1", "fig2", "fig3"]
+    let files: Vec<PathBuf> = ["fig1", "fig2", "fig3", "fig4"]
         .iter()
         .map(|n| dir.join(format!("{n}.toml")))
         .collect();
