@@ -348,3 +348,43 @@ strategy = "bsdf"
     );
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// The samplers' figure in its quick form: every (strategy, sampler) column has its rows,
+/// and the report has the rates table with a bootstrap interval for each.
+#[test]
+fn quick_fig4_crosses_samplers_and_reports_rates() {
+    let out = scratch("fig4");
+    let o = run_quick("experiments/fig4.toml", &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let dir = out.join("fig4-quick");
+    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    // [quick]: 3 strategies x 5 samplers x spp [1, 4, 16] x 4 seeds.
+    assert_eq!(csv.lines().count() - 1, 3 * 5 * 3 * 4, "{csv}");
+    let index = std::fs::read_to_string(dir.join("index.md")).unwrap();
+    let rates = &index[index.find("## Convergence rates").expect("rates table")..];
+    let rates = &rates[..rates[3..].find("\n## ").map_or(rates.len(), |i| i + 3)];
+    for name in [
+        "light, independent",
+        "BSDF, sobol:padded",
+        "MIS power, sobol-xor",
+    ] {
+        let row = rates
+            .lines()
+            .find(|l| l.starts_with(&format!("| {name} |")))
+            .unwrap_or_else(|| panic!("no row {name}: {rates}"));
+        assert!(row.contains("4→16"), "{row}");
+    }
+    // A slope comes with its interval (points near the quick reference's noise floor leave
+    // some columns without either).
+    let rows: Vec<&str> = rates
+        .lines()
+        .filter(|l| l.contains(", ") && l.starts_with("| "))
+        .collect();
+    assert_eq!(rows.len(), 15, "{rates}");
+    for row in &rows {
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        assert_eq!(cells[2] == "-", cells[3] == "-", "{row}");
+    }
+    assert!(rows.iter().any(|r| r.contains('[')), "{rates}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
