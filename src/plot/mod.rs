@@ -21,9 +21,11 @@ pub fn register_font() {
     });
 }
 
-/// Colour of the i-th series: Tableau 10, readable on white and for common colour blindness.
+/// Colour of the i-th series: Tableau 20, readable on white and for common colour
+/// blindness: the ten strong colours first, then their light companions in the same order
+/// (a sampler figure has 15 series: strategies x samplers).
 pub fn series_colour(i: usize) -> RGBColor {
-    const C: [(u8, u8, u8); 10] = [
+    const C: [(u8, u8, u8); 20] = [
         (31, 119, 180),
         (255, 127, 14),
         (44, 160, 44),
@@ -34,6 +36,16 @@ pub fn series_colour(i: usize) -> RGBColor {
         (127, 127, 127),
         (188, 189, 34),
         (23, 190, 207),
+        (174, 199, 232),
+        (255, 187, 120),
+        (152, 223, 138),
+        (255, 152, 150),
+        (197, 176, 213),
+        (196, 156, 148),
+        (247, 182, 210),
+        (199, 199, 199),
+        (219, 219, 141),
+        (158, 218, 229),
     ];
     let (r, g, b) = C[i % C.len()];
     RGBColor(r, g, b)
@@ -189,6 +201,18 @@ pub fn write_chart(stem: &Path, c: &LogLogChart) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Twenty series get twenty different colours (fig4 draws 15).
+    #[test]
+    fn twenty_series_colours_differ() {
+        let cs: std::collections::HashSet<_> = (0..20)
+            .map(|i| {
+                let c = series_colour(i);
+                (c.0, c.1, c.2)
+            })
+            .collect();
+        assert_eq!(cs.len(), 20);
+    }
 
     #[test]
     fn chart_writes_png_with_text_and_svg() {
