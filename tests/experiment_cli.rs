@@ -7,6 +7,23 @@ use common::{directlab, repo, run, scratch};
 use std::path::Path;
 use std::process::Output;
 
+/// A closed cube whose inside emits radiance 1 and reflects half: 1.5 in every pixel.
+const FURNACE: &str = r#"<scene version="3.0.0">
+    <sensor type="perspective">
+        <float name="fov" value="60"/>
+        <film type="hdrfilm">
+            <integer name="width" value="6"/>
+            <integer name="height" value="4"/>
+        </film>
+    </sensor>
+    <shape type="cube">
+        <boolean name="flip_normals" value="true"/>
+        <transform name="to_world"><scale value="2"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>
+        <emitter type="area"><rgb name="radiance" value="1"/></emitter>
+    </shape>
+</scene>"#;
+
 /// `directlab run EXP --out OUT`, which must succeed.
 fn run_ok(exp: &Path, out: &Path) {
     let o = run(directlab().args(["run", exp.to_str().unwrap(), "--out", out.to_str().unwrap()]));
@@ -156,25 +173,7 @@ emitter_selection = "power"
 #[test]
 fn image_sweep_with_a_constant_reference() {
     let out = scratch("constant");
-    std::fs::write(
-        out.join("furnace.xml"),
-        r#"<scene version="3.0.0">
-    <sensor type="perspective">
-        <float name="fov" value="60"/>
-        <film type="hdrfilm">
-            <integer name="width" value="6"/>
-            <integer name="height" value="4"/>
-        </film>
-    </sensor>
-    <shape type="cube">
-        <boolean name="flip_normals" value="true"/>
-        <transform name="to_world"><scale value="2"/></transform>
-        <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>
-        <emitter type="area"><rgb name="radiance" value="1"/></emitter>
-    </shape>
-</scene>"#,
-    )
-    .unwrap();
+    std::fs::write(out.join("furnace.xml"), FURNACE).unwrap();
     let exp = out.join("furnace.toml");
     std::fs::write(
         &exp,
@@ -249,25 +248,7 @@ fn quick_fig3_reads_a_tiny_light_as_a_tail_not_a_bias() {
 #[test]
 fn samplers_axis_crosses_strategies() {
     let out = scratch("samplers");
-    std::fs::write(
-        out.join("furnace.xml"),
-        r#"<scene version="3.0.0">
-    <sensor type="perspective">
-        <float name="fov" value="60"/>
-        <film type="hdrfilm">
-            <integer name="width" value="6"/>
-            <integer name="height" value="4"/>
-        </film>
-    </sensor>
-    <shape type="cube">
-        <boolean name="flip_normals" value="true"/>
-        <transform name="to_world"><scale value="2"/></transform>
-        <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>
-        <emitter type="area"><rgb name="radiance" value="1"/></emitter>
-    </shape>
-</scene>"#,
-    )
-    .unwrap();
+    std::fs::write(out.join("furnace.xml"), FURNACE).unwrap();
     let text = |samplers: &str| {
         format!(
             r#"

@@ -43,17 +43,25 @@ pub fn throughputs(
     let (w, h) = (scene.camera.width, scene.camera.height);
     let samples = w as f64 * h as f64 * spp as f64;
     best_of_turns(strategies, threads, repeat, samples, |strategy, t| {
-        let settings = RenderSettings {
-            spp,
-            seed: 1,
-            first_sample: 0,
-            threads: Some(t),
-            progress: false,
-            sampling: Default::default(),
-        };
-        let out = render(scene, strategy, &settings);
-        (out.seconds, out.busy_seconds)
+        timed(scene, strategy, SamplerKind::Independent, spp, t)
     })
+}
+
+/// One timed render at seed 1: (seconds, busy worker seconds).
+fn timed(scene: &Scene, strategy: Strategy, kind: SamplerKind, spp: u32, t: usize) -> (f64, f64) {
+    let settings = RenderSettings {
+        spp,
+        seed: 1,
+        first_sample: 0,
+        threads: Some(t),
+        progress: false,
+        sampling: Sampling {
+            kind,
+            ..Default::default()
+        },
+    };
+    let out = render(scene, strategy, &settings);
+    (out.seconds, out.busy_seconds)
 }
 
 /// Render throughput of `scene` with one strategy and each sampler, timed in turns as
@@ -69,19 +77,7 @@ pub fn sampler_throughputs(
     let (w, h) = (scene.camera.width, scene.camera.height);
     let samples = w as f64 * h as f64 * spp as f64;
     best_of_turns(samplers, threads, repeat, samples, |kind, t| {
-        let settings = RenderSettings {
-            spp,
-            seed: 1,
-            first_sample: 0,
-            threads: Some(t),
-            progress: false,
-            sampling: Sampling {
-                kind,
-                ..Default::default()
-            },
-        };
-        let out = render(scene, strategy, &settings);
-        (out.seconds, out.busy_seconds)
+        timed(scene, strategy, kind, spp, t)
     })
 }
 
