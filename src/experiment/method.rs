@@ -126,19 +126,11 @@ pub fn cross(strategies: &[(String, Strategy)], samplers: &[SamplerSpec]) -> Vec
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::emitter::{EmitterSelection, LightSampling};
-    use crate::scene::desc::{Heuristic, StrategyKind};
+    use crate::scene::desc::StrategyKind;
 
+    /// Light sampling, uniform emitter choice, area points.
     fn strategy() -> Strategy {
-        Strategy {
-            kind: StrategyKind::Light,
-            heuristic: Heuristic::Balance,
-            emitter_samples: 1,
-            bsdf_samples: 1,
-            selection: EmitterSelection::Uniform,
-            light_sampling: LightSampling::Area,
-            hide_emitters: false,
-        }
+        Strategy::combinations()[0]
     }
 
     #[test]

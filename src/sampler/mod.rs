@@ -226,6 +226,24 @@ pub trait Sampler {
     fn bsdf(&mut self) -> BsdfDims;
 }
 
+/// One camera sample's groups in allocation order, as the ten values they hold (tests).
+#[cfg(test)]
+pub(crate) fn all_values(s: &mut impl Sampler) -> [f32; 10] {
+    let (f, t, l, b) = (s.film(), s.technique(), s.light(), s.bsdf());
+    [
+        f.x,
+        f.y,
+        t,
+        l.select,
+        l.primitive,
+        l.point.x,
+        l.point.y,
+        b.lobe,
+        b.direction.x,
+        b.direction.y,
+    ]
+}
+
 /// `LANES` consecutive camera samples of one pixel, lane i being sample `s0 + i`; each group
 /// gives one array per dimension. Lane i at any point is [`lane`](SamplerLanes::lane)(i), so
 /// a lane the kernel does not cover continues on the scalar path with the same numbers.

@@ -313,20 +313,7 @@ mod tests {
         for dims in [DimAlloc::Joint, DimAlloc::Padded] {
             let draw = |seed: u64| {
                 let px = SobolLanes::pixel(&cfg(seed, dims), 2, 2);
-                let mut s = PureSample::new(px, 3);
-                let (f, t, l, b) = (s.film(), s.technique(), s.light(), s.bsdf());
-                [
-                    f.x,
-                    f.y,
-                    t,
-                    l.select,
-                    l.primitive,
-                    l.point.x,
-                    l.point.y,
-                    b.lobe,
-                    b.direction.x,
-                    b.direction.y,
-                ]
+                crate::sampler::all_values(&mut PureSample::new(px, 3))
             };
             let (a, b) = (draw(1), draw(2));
             for k in 0..a.len() {

@@ -164,22 +164,7 @@ mod tests {
 
     #[test]
     fn every_dimension_changes_with_the_seed() {
-        let draw = |seed| {
-            let mut s = PureSample::new(pixel(16, seed), 5);
-            let (f, t, l, b) = (s.film(), s.technique(), s.light(), s.bsdf());
-            [
-                f.x,
-                f.y,
-                t,
-                l.select,
-                l.primitive,
-                l.point.x,
-                l.point.y,
-                b.lobe,
-                b.direction.x,
-                b.direction.y,
-            ]
-        };
+        let draw = |seed| crate::sampler::all_values(&mut PureSample::new(pixel(16, seed), 5));
         let (a, b) = (draw(1), draw(2));
         for k in 0..a.len() {
             assert_ne!(a[k], b[k], "dimension {k}");
