@@ -404,3 +404,7 @@ pub fn chi2_test<D: Domain>(
 #[cfg(test)]
 #[path = "chi2_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "chi2_boundary_tests.rs"]
+mod boundary_tests;
