@@ -259,8 +259,7 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
             run_samples: None,
         },
     };
-    let width = scene.camera.width;
-    settings.sampler_config(width)?;
+    settings.sampler_config((scene.camera.width, scene.camera.height))?;
     let result = render(&scene, strategy, &settings);
     film::write_exr(&out, &result.mean)?;
     film::write_png(&out.with_extension("png"), &result.mean)?;

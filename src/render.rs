@@ -45,9 +45,9 @@ pub struct RenderSettings {
 
 impl RenderSettings {
     /// The sampler's configuration for this render, or why it cannot draw its samples.
-    pub fn sampler_config(&self, width: u32) -> Result<SamplerConfig, String> {
+    pub fn sampler_config(&self, film: (u32, u32)) -> Result<SamplerConfig, String> {
         self.sampling
-            .config(self.seed, self.first_sample, self.spp, width)
+            .config(self.seed, self.first_sample, self.spp, film)
     }
 }
 
@@ -262,9 +262,10 @@ pub fn render_rows(
     settings: &RenderSettings,
     scratch: &mut LaneScratch,
 ) -> f64 {
-    let w = kernel.direct.scene.camera.width;
+    let cam = &kernel.direct.scene.camera;
+    let w = cam.width;
     let cfg = settings
-        .sampler_config(w)
+        .sampler_config((w, cam.height))
         .expect("sampler settings checked by the caller");
     rows.flat_map(|y| (0..w).map(move |x| (x, y)))
         .map(|(x, y)| render_any_pixel(kernel, x, y, settings, &cfg, scratch).mean[0])
@@ -275,7 +276,7 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
     let (w, h) = (scene.camera.width, scene.camera.height);
     let kernel = LaneKernel::new(scene, strategy);
     let cfg = settings
-        .sampler_config(w)
+        .sampler_config((w, h))
         .expect("sampler settings checked by the caller");
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))

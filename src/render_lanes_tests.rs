@@ -44,7 +44,7 @@ fn per_sample_mismatch(
     let out = render(scene, strategy, settings);
     let direct = crate::integrator::Direct::new(scene, strategy);
     let cam = &scene.camera;
-    let cfg = settings.sampler_config(cam.width)?;
+    let cfg = settings.sampler_config((cam.width, cam.height))?;
     let mut lit = 0;
     for y in 0..cam.height {
         for x in 0..cam.width {

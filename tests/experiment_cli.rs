@@ -270,7 +270,7 @@ strategy = "bsdf"
     let exp = out.join("furnace.toml");
     std::fs::write(
         &exp,
-        text(r#"["independent", "stratified", "sobol", "sobol:padded", "sobol-xor"]"#),
+        text(r#"["independent", "stratified", "sobol", "sobol:padded", "sobol-xor", "zsobol"]"#),
     )
     .unwrap();
     run_ok(&exp, &out);
@@ -280,9 +280,9 @@ strategy = "bsdf"
             .deserialize()
             .collect::<Result<_, _>>()
             .unwrap();
-    assert_eq!(rows.len(), 2 * 5 * 2 * 2);
+    assert_eq!(rows.len(), 2 * 6 * 2 * 2);
     let labels: std::collections::BTreeSet<_> = rows.iter().map(|r| r.strategy.clone()).collect();
-    assert_eq!(labels.len(), 10, "{labels:?}");
+    assert_eq!(labels.len(), 12, "{labels:?}");
     assert!(
         labels.iter().any(|l| l.ends_with("~sobol-padded")),
         "{labels:?}"
@@ -325,6 +325,19 @@ strategy = "bsdf"
     assert_eq!(bad.status.code(), Some(1), "{err}");
     assert!(
         err.contains("furnace.toml") && err.contains("unknown sampler 'sobl'"),
+        "{err}"
+    );
+    // zsobol numbers the whole film's samples in one sequence: a run past it is refused
+    // before anything renders, naming the file, the film and the limit.
+    let huge = text(r#"["zsobol"]"#).replace("spp = [4, 16]", "spp = [4, 134217728]");
+    std::fs::write(&exp, huge).unwrap();
+    let bad = run(directlab().args(["run", exp.to_str().unwrap(), "--out", out.to_str().unwrap()]));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert_eq!(bad.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("furnace.toml")
+            && err.contains("6x4 film")
+            && err.contains("at most 67108864 samples per pixel"),
         "{err}"
     );
     std::fs::remove_dir_all(&out).unwrap();

@@ -54,18 +54,19 @@ struct Ctx<'a> {
 }
 
 fn execute(ctx: &Ctx, job: &Job) -> Result<Row, String> {
-    let out = render(
-        ctx.scene,
-        job.method.strategy,
-        &RenderSettings {
-            spp: job.spp,
-            seed: job.seed,
-            first_sample: 0,
-            threads: ctx.threads,
-            progress: false,
-            sampling: job.method.sampler.sampling(),
-        },
-    );
+    let settings = RenderSettings {
+        spp: job.spp,
+        seed: job.seed,
+        first_sample: 0,
+        threads: ctx.threads,
+        progress: false,
+        sampling: job.method.sampler.sampling(),
+    };
+    let cam = &ctx.scene.camera;
+    settings
+        .sampler_config((cam.width, cam.height))
+        .map_err(|e| format!("{} at {} spp: {e}", job.method.label(), job.spp))?;
+    let out = render(ctx.scene, job.method.strategy, &settings);
     if let Some(p) = &job.image {
         film::write_exr(p, &out.mean)?;
         film::write_exr(&variance_path(p), &out.variance)?;
@@ -218,6 +219,15 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
     let (kept, omitted) = strategies(&exp, base, &scene)?;
 
     let x = &exp.exp;
+    // A sampler that cannot draw the sweep's largest run fails before anything renders.
+    let film = (scene.camera.width, scene.camera.height);
+    let most = x.spp.iter().copied().max().unwrap_or(1);
+    for (_, m) in &kept {
+        m.sampler
+            .sampling()
+            .config(0, 0, most, film)
+            .map_err(|e| format!("{}: samplers: {e}", exp.file.display()))?;
+    }
     let eps = x.metrics.relmse_epsilon;
     let ref_strategy = x
         .reference

@@ -141,6 +141,7 @@ mod tests {
             seed: 5,
             run_samples: 64,
             width: 100,
+            height: 100,
         };
         let mut lanes = IndependentLanes::start(IndependentLanes::pixel(&cfg, 77, 0), 16);
         let [fx, fy] = lanes.film();

@@ -35,6 +35,7 @@ pub mod permute;
 pub mod pure;
 pub mod sobol;
 pub mod stratified;
+pub mod zsobol;
 
 use crate::rng::LANES;
 use glam::Vec2;
@@ -58,14 +59,20 @@ pub enum SamplerKind {
     #[value(name = "sobol-xor")]
     #[serde(rename = "sobol-xor")]
     SobolXor,
+    /// One Owen-scrambled Sobol' sequence for the film, handed to pixels in Morton order
+    /// with random base-4 digit permutations: errors as blue noise on the screen (pbrt-v4).
+    #[value(name = "zsobol")]
+    #[serde(rename = "zsobol")]
+    ZSobol,
 }
 
 impl SamplerKind {
-    pub const ALL: [SamplerKind; 4] = [
+    pub const ALL: [SamplerKind; 5] = [
         SamplerKind::Independent,
         SamplerKind::Stratified,
         SamplerKind::Sobol,
         SamplerKind::SobolXor,
+        SamplerKind::ZSobol,
     ];
 
     /// The name the CLI, scene files and experiment files use.
@@ -75,18 +82,23 @@ impl SamplerKind {
             SamplerKind::Stratified => "stratified",
             SamplerKind::Sobol => "sobol",
             SamplerKind::SobolXor => "sobol-xor",
+            SamplerKind::ZSobol => "zsobol",
         }
     }
 
-    /// Whether the sampler must know the run's sample count in advance (its strata).
+    /// Whether the sampler must know the run's sample count in advance (its strata, or
+    /// the block of the sequence each pixel takes).
     pub fn needs_sample_count(self) -> bool {
-        self == SamplerKind::Stratified
+        matches!(self, SamplerKind::Stratified | SamplerKind::ZSobol)
     }
 
     /// Whether the dimension allocation (`DimAlloc`) changes the sampler's points: the
     /// independent sampler has no sets, the stratified one is always padded.
     pub fn allocates_dims(self) -> bool {
-        matches!(self, SamplerKind::Sobol | SamplerKind::SobolXor)
+        matches!(
+            self,
+            SamplerKind::Sobol | SamplerKind::SobolXor | SamplerKind::ZSobol
+        )
     }
 }
 
@@ -131,7 +143,7 @@ impl Sampling {
         seed: u64,
         first: u64,
         spp: u32,
-        width: u32,
+        (width, height): (u32, u32),
     ) -> Result<SamplerConfig, String> {
         let end = first + spp as u64;
         let run_samples = self.run_samples.unwrap_or(end);
@@ -151,11 +163,27 @@ impl Sampling {
                 ));
             }
         }
+        if self.kind == SamplerKind::ZSobol {
+            let bits = zsobol::index_bits(width, height, run_samples);
+            if bits > zsobol::INDEX_BITS {
+                let pixel_bits = bits - zsobol::ceil_log2(run_samples);
+                let most = match zsobol::INDEX_BITS.checked_sub(pixel_bits) {
+                    Some(b) => format!("at most {} samples per pixel", 1u64 << b),
+                    None => "no samples (its side is over 65,536 pixels)".to_string(),
+                };
+                return Err(format!(
+                    "the zsobol sampler numbers every sample of the film in one sequence of \
+                     2^{} points: a {width}x{height} film takes {most} ({run_samples} asked for)",
+                    zsobol::INDEX_BITS
+                ));
+            }
+        }
         Ok(SamplerConfig {
             dims: self.dims,
             seed,
             run_samples,
             width,
+            height,
         })
     }
 }
@@ -175,6 +203,7 @@ impl SamplerKind {
             SamplerKind::Stratified => v.visit::<stratified::StratifiedLanes>(),
             SamplerKind::Sobol => v.visit::<sobol::SobolLanes>(),
             SamplerKind::SobolXor => v.visit::<sobol::SobolXorLanes>(),
+            SamplerKind::ZSobol => v.visit::<zsobol::ZSobolLanes>(),
         }
     }
 }
@@ -189,6 +218,8 @@ pub struct SamplerConfig {
     pub run_samples: u64,
     /// The film's width, which numbers the pixels.
     pub width: u32,
+    /// The film's height (zsobol's Morton codes span the larger side).
+    pub height: u32,
 }
 
 impl SamplerConfig {

@@ -184,6 +184,7 @@ mod tests {
             seed,
             run_samples: 1 << 20,
             width: 64,
+            height: 64,
         }
     }
 

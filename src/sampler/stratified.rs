@@ -92,6 +92,7 @@ mod tests {
             seed,
             run_samples: n,
             width: 8,
+            height: 8,
         };
         StratifiedLanes::pixel(&c, 3, 4)
     }

@@ -339,6 +339,7 @@ impl<'a> Loader<'a> {
             "stratified" => (SamplerKind::Stratified, false),
             "sobol" => (SamplerKind::Sobol, false),
             "sobol-xor" => (SamplerKind::SobolXor, false),
+            "zsobol" => (SamplerKind::ZSobol, false),
             "multijitter" | "orthogonal" => (SamplerKind::Stratified, true),
             "ldsampler" | "low_discrepancy" | "halton" | "hammersley" => (SamplerKind::Sobol, true),
             t if KNOWN_SAMPLERS.contains(&t) => (SamplerKind::Independent, true),
@@ -347,8 +348,8 @@ impl<'a> Loader<'a> {
                     e,
                     "sampler",
                     t,
-                    "independent, stratified, sobol, sobol-xor (or Mitsuba's multijitter, \
-                     orthogonal, ldsampler)",
+                    "independent, stratified, sobol, sobol-xor, zsobol (or Mitsuba's \
+                     multijitter, orthogonal, ldsampler)",
                 ))
             }
         };
