@@ -248,7 +248,7 @@ impl PointSet for ZSobol {
     #[inline(always)]
     fn draw_lanes(px: &ZPixel, s0: u64, dim: u32, k: usize) -> [[f32; LANES]; 4] {
         let m0 = px.morton(s0);
-        let index: [u64; LANES] = if px.log2_spp >= LOW && m0 % LANES as u64 == 0 {
+        let index: [u64; LANES] = if px.log2_spp >= LOW && m0.is_multiple_of(LANES as u64) {
             let high = px.permute_digits(m0, dim, LOW, u32::MAX);
             px.low_lanes(m0, dim).map(|low| high | low)
         } else {
