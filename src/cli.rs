@@ -24,14 +24,17 @@ pub enum Command {
     Render(RenderArgs),
     /// Run experiments (sweeps against a cached reference) and write their reports.
     Run(RunArgs),
-    /// Run the study's figures (experiments fig1, fig2, fig3) and the samplers' (fig4), and
-    /// write their reports.
+    /// Run the study's figures (experiments fig1, fig2, fig3), the samplers' (fig4) and
+    /// their test integrands, and write their reports.
     Reproduce(ReproduceArgs),
     /// Measure render throughput per strategy and thread count.
     Bench(crate::bench::BenchArgs),
     /// Chi-square tests of every sampling routine against its pdf (warps, BSDFs, emitters),
     /// with heat maps; exits non-zero if any case fails.
     Chi2(crate::chi2cases::command::Chi2Args),
+    /// The 2D test integrands of Christensen, Kensler and Kilpatrick 2018 integrated by
+    /// every sampler's first 2D pair: RMSE against N, slopes against the published rates.
+    Integrands(crate::integrands::report::IntegrandsArgs),
     /// The stability suite of extreme scenes (finiteness, bias and variance per strategy):
     /// short for `run experiments/extreme.toml`.
     Extreme(ExtremeArgs),
@@ -136,7 +139,15 @@ fn cmd_reproduce(a: &ReproduceArgs) -> Result<(), String> {
         .iter()
         .map(|n| dir.join(format!("{n}.toml")))
         .collect();
-    run_files(&files, &a.sweep)
+    let integrands = crate::integrands::report::IntegrandsArgs {
+        quick: a.sweep.quick,
+        out: a.sweep.out.clone(),
+        ..Default::default()
+    };
+    let ran = run_files(&files, &a.sweep);
+    crate::integrands::report::run(&integrands)?;
+    crate::report::write_root_index(&a.sweep.out)?;
+    ran
 }
 
 #[derive(Args, Debug)]
@@ -314,6 +325,7 @@ pub fn main() -> i32 {
         Command::Render(a) => cmd_render(a),
         Command::Run(a) => cmd_run(a),
         Command::Reproduce(a) => cmd_reproduce(a),
+        Command::Integrands(a) => crate::integrands::report::run(a).map(|_| ()),
         Command::Bench(a) => crate::bench::run(a),
         Command::Chi2(a) => crate::chi2cases::command::run(a).and_then(|ok| {
             ok.then_some(())

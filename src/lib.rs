@@ -13,6 +13,7 @@ pub mod emitter;
 pub mod experiment;
 pub mod film;
 pub mod geometry;
+pub mod integrands;
 pub mod integrator;
 pub mod math;
 pub mod metrics;

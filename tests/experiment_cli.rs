@@ -352,8 +352,10 @@ fn quick_fig4_crosses_samplers_and_reports_rates() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let dir = out.join("fig4-quick");
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
-    // [quick]: 3 strategies x 5 samplers x spp [1, 4, 16] x 4 seeds.
-    assert_eq!(csv.lines().count() - 1, 3 * 5 * 3 * 4, "{csv}");
+    // [quick]: 3 strategies x 6 samplers x spp [1, 4, 16] x 4 seeds, and an equal-time run
+    // of each column.
+    assert_eq!(csv.lines().count() - 1, 3 * 6 * 3 * 4 + 3 * 6, "{csv}");
+    assert!(dir.join("equal_time_0.01s.png").is_file());
     let index = std::fs::read_to_string(dir.join("index.md")).unwrap();
     let rates = &index[index.find("## Convergence rates").expect("rates table")..];
     let rates = &rates[..rates[3..].find("\n## ").map_or(rates.len(), |i| i + 3)];
@@ -361,6 +363,7 @@ fn quick_fig4_crosses_samplers_and_reports_rates() {
         "light, independent",
         "BSDF, sobol:padded",
         "MIS power, sobol-xor",
+        "MIS power, zsobol",
     ] {
         let row = rates
             .lines()
@@ -374,7 +377,7 @@ fn quick_fig4_crosses_samplers_and_reports_rates() {
         .lines()
         .filter(|l| l.contains(", ") && l.starts_with("| "))
         .collect();
-    assert_eq!(rows.len(), 15, "{rates}");
+    assert_eq!(rows.len(), 18, "{rates}");
     for row in &rows {
         let cells: Vec<&str> = row.split('|').map(str::trim).collect();
         assert_eq!(cells[2] == "-", cells[3] == "-", "{row}");

@@ -57,6 +57,8 @@ pub struct Line {
     pub label: String,
     pub points: Vec<(f64, f64)>,
     pub spread: Vec<(f64, f64)>,
+    /// Palette index ([`series_colour`]); None: the line's own index.
+    pub colour: Option<usize>,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -126,7 +128,7 @@ where
         .draw()
         .map_err(e)?;
     for (i, l) in c.lines.iter().enumerate() {
-        let col = series_colour(i);
+        let col = series_colour(l.colour.unwrap_or(i));
         let pts: Vec<(f64, f64)> = l.points.iter().cloned().filter(|p| p.1 > 0.0).collect();
         chart
             .draw_series(LineSeries::new(pts.clone(), col.stroke_width(2)))
@@ -225,6 +227,7 @@ mod tests {
                 label: "light (slope -1.00)".into(),
                 points: vec![(1.0, 1.0), (4.0, 0.25), (16.0, 0.0625)],
                 spread: vec![(0.8, 1.2), (0.2, 0.3), (0.05, 0.07)],
+                colour: None,
             }],
             hline: Some((0.01, "reference noise".into())),
         };

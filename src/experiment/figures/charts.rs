@@ -22,6 +22,7 @@ pub fn charts(o: &Outcome) -> Result<(Vec<Series>, Vec<Figure>), String> {
         },
         points: s.points.iter().map(f).collect(),
         spread: s.points.iter().map(|p| (p.min, p.max)).collect(),
+        colour: None,
     };
     let mut figs = Vec::new();
     let mut chart = |file: &str, c: LogLogChart, caption: String| -> Result<(), String> {
@@ -75,6 +76,7 @@ pub fn charts(o: &Outcome) -> Result<(Vec<Series>, Vec<Figure>), String> {
                 .map(|p| (p.spp as f64, p.efficiency()))
                 .collect(),
             spread: vec![],
+            colour: None,
         })
         .collect();
     chart(
