@@ -51,6 +51,17 @@ fn integrands_report_rates_against_the_published_ones() {
             );
         }
     }
+    // The pixel check: every case, strategy and sampler (all of them, with sobol:padded),
+    // and a chart per case.
+    for case in ["unoccluded", "penumbra"] {
+        for strategy in ["light", "BSDF", "MIS power"] {
+            for sampler in ["independent", "zsobol", "sobol:padded"] {
+                let head = format!("| {case} | {strategy} | {sampler} | -");
+                assert!(md.contains(&head), "no row {head}: {md}");
+            }
+        }
+        assert!(dir.join(format!("pixel-{case}.png")).is_file());
+    }
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
     // Counts 16, 23, 32, 45, 64, 91, 128, 181, 256.
     assert_eq!(csv.lines().count(), 1 + 5 * 3 * 9, "{csv}");

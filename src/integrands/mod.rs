@@ -7,6 +7,7 @@
 //! (`run_samples = N`), as a render of N samples per pixel is, so the stratified sampler's
 //! strata and zsobol's blocks are laid out for N.
 
+pub mod pixel;
 pub mod report;
 
 use crate::sampler::{DimAlloc, LanesVisitor, SamplerConfig, SamplerKind, SamplerLanes, Sampling};
