@@ -135,7 +135,7 @@ fn cmd_extreme(a: &ExtremeArgs) -> Result<(), String> {
 
 fn cmd_reproduce(a: &ReproduceArgs) -> Result<(), String> {
     let dir = crate::experiment::experiments_dir()?;
-    let files: Vec<PathBuf> = ["fig1", "fig2", "fig3", "fig4"]
+    let files: Vec<PathBuf> = ["fig1", "fig2", "fig3", "fig4", "fig4-veach"]
         .iter()
         .map(|n| dir.join(format!("{n}.toml")))
         .collect();

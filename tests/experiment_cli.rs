@@ -385,3 +385,19 @@ fn quick_fig4_crosses_samplers_and_reports_rates() {
     assert!(rows.iter().any(|r| r.contains('[')), "{rates}");
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// The samplers' figure on the Veach scene, quick: every (strategy, sampler) column at every
+/// spp and seed, an equal-time run of each, and crops.
+#[test]
+fn quick_fig4_veach_runs_every_column() {
+    let out = scratch("fig4-veach");
+    let o = run_quick("experiments/fig4-veach.toml", &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let dir = out.join("fig4-veach-quick");
+    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    // [quick]: 3 strategies x 5 samplers x spp [1, 4, 16] x 4 seeds, and equal time.
+    assert_eq!(csv.lines().count() - 1, 3 * 5 * 3 * 4 + 3 * 5, "{csv}");
+    let index = std::fs::read_to_string(dir.join("index.md")).unwrap();
+    assert!(index.contains("| BSDF, sobol:padded |"), "{index}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
