@@ -408,3 +408,7 @@ mod tests;
 #[cfg(test)]
 #[path = "chi2_boundary_tests.rs"]
 mod boundary_tests;
+
+#[cfg(test)]
+#[path = "chi2_rules_tests.rs"]
+mod rules_tests;

@@ -198,7 +198,7 @@ fn boundary_pass_finds_a_tip_between_the_first_nodes() {
 }
 
 /// A disk of radius 0.02 on the central node of a start rectangle of cell (3, 3).
-fn disk_evaluations(density: f64) -> (usize, f64) {
+fn disk_evaluations(density: f64, initial_split: usize) -> (usize, f64) {
     let (cx, cy) = (0.40625, 0.40625);
     let points = RefCell::new(Vec::new());
     let pdf = |p: Vec2| {
@@ -212,6 +212,7 @@ fn disk_evaluations(density: f64) -> (usize, f64) {
     };
     let cfg = Integration {
         max_depth: 4,
+        initial_split,
         ..config(0)
     };
     let (grid, _) = cell_integrals(&UnitSquare { n: N }, pdf, &cfg);
@@ -225,8 +226,8 @@ fn rectangles_are_refined_down_to_a_billionth_of_the_total() {
     // cell here, so 1/1024 of the domain) is refined at an edge when its peak density times
     // its area exceeds 1e-9 / 64 / 4, i.e. when the density exceeds 1e-9.
     let exact = |density: f64| density * std::f64::consts::PI * 0.02f64.powi(2);
-    let (n_hi, got_hi) = disk_evaluations(2e-9);
-    let (n_lo, _) = disk_evaluations(0.5e-9);
+    let (n_hi, got_hi) = disk_evaluations(2e-9, 2);
+    let (n_lo, _) = disk_evaluations(0.5e-9, 2);
     // Below the threshold a cell costs its 2 x 2 start rectangles' 5 x 5 nodes, of which
     // 4 x 4 each lie inside the cell (a rectangle's nodes on the cell's middle lines are
     // its own, so they count twice).
@@ -239,5 +240,20 @@ fn rectangles_are_refined_down_to_a_billionth_of_the_total() {
         (got_hi - exact(2e-9)).abs() < 0.02 * exact(2e-9),
         "{got_hi} vs {}",
         exact(2e-9)
+    );
+}
+
+/// The threshold is a density whatever the start split: with 4 x 4 start rectangles (each
+/// 1/16 the area) it is still 1e-9, so a disk at 1.5e-9 is refined and one at 0.5e-9 costs
+/// only the start rectangles' nodes: along each axis 4 + 5 + 5 + 4 inside the cell (the
+/// middle rectangles' nodes on both their sides), 18 x 18.
+#[test]
+fn the_neglect_threshold_does_not_depend_on_the_start_split() {
+    let (n_lo, _) = disk_evaluations(0.5e-9, 4);
+    assert_eq!(n_lo, 18 * 18);
+    let (n_hi, _) = disk_evaluations(1.5e-9, 4);
+    assert!(
+        n_hi > 2 * 16 * 16,
+        "{n_hi} evaluations: the disk's rim was not refined"
     );
 }

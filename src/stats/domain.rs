@@ -269,4 +269,63 @@ mod tests {
         assert!(t.point(0.6, 0.6).is_none());
         assert_eq!(t.cell_of(Vec2::new(1.0, 0.0)).unwrap(), (50, 0));
     }
+
+    /// Every domain maps a point to its (u, v) and back to the same point, at points spread
+    /// over it (a pdf that is constant on the domain cannot see a wrong `point`).
+    #[test]
+    fn every_domain_round_trips_its_points() {
+        let d = Disk::default();
+        for p in [
+            Vec2::new(0.3, -0.6),
+            Vec2::new(-0.9, 0.1),
+            Vec2::new(0.05, 0.7),
+        ] {
+            let (u, v) = d.locate(p).unwrap();
+            let q = d.point(u, v).unwrap();
+            assert!((q - p).length() < 1e-6, "disk {p} -> ({u}, {v}) -> {q}");
+        }
+        let sq = UnitSquare::default();
+        let t = Triangle::default();
+        for p in [
+            Vec2::new(0.2, 0.7),
+            Vec2::new(0.9, 0.05),
+            Vec2::new(0.4, 0.4),
+        ] {
+            let (u, v) = sq.locate(p).unwrap();
+            assert_eq!(sq.point(u, v).unwrap(), p);
+            let (u, v) = t.locate(p).unwrap();
+            assert_eq!(t.point(u, v).unwrap(), p);
+        }
+        // A direction a little off unit length is normalised before it is located.
+        let s = Sphere::default();
+        let dir = Vec3::new(0.36, 0.48, 0.8);
+        let (u0, v0) = s.locate(dir).unwrap();
+        let (u1, v1) = s.locate(dir * 1.0008).unwrap();
+        assert!(
+            (u0 - u1).abs() < 1e-6 && (v0 - v1).abs() < 1e-6,
+            "{v0} vs {v1}"
+        );
+    }
+
+    #[test]
+    fn the_unit_square_refuses_either_coordinate_outside() {
+        let sq = UnitSquare::default();
+        for p in [
+            Vec2::new(1.5, 0.5),
+            Vec2::new(0.5, -0.2),
+            Vec2::new(-0.1, 2.0),
+        ] {
+            assert!(sq.locate(p).is_err(), "{p}");
+        }
+        assert!(sq.locate(Vec2::new(0.0, 1.0)).is_ok());
+    }
+
+    /// Reports and heat maps name the domain.
+    #[test]
+    fn domains_have_their_names() {
+        assert_eq!(Sphere::default().name(), "sphere");
+        assert_eq!(UnitSquare::default().name(), "unit square");
+        assert_eq!(Disk::default().name(), "unit disk");
+        assert_eq!(Triangle::default().name(), "unit triangle");
+    }
 }

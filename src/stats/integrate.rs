@@ -209,4 +209,21 @@ mod tests {
         // Refinement stays near the rim instead of covering the whole square.
         assert!(evals < 200_000, "{evals} evaluations");
     }
+
+    /// Refinement is forced by an edge (a node at 0 beside positive ones) or a jump beyond
+    /// the ratio, never by constant or all-zero nodes.
+    #[test]
+    fn discontinuity_rule() {
+        let with = |lo: f64, hi: f64| {
+            let mut n = [[hi; 5]; 5];
+            n[2][3] = lo;
+            n
+        };
+        assert!(!looks_discontinuous(&[[0.0; 5]; 5], 2.0));
+        assert!(!looks_discontinuous(&[[0.7; 5]; 5], 2.0));
+        assert!(looks_discontinuous(&with(0.0, 1.0), 2.0));
+        assert!(looks_discontinuous(&with(1.0, 3.0), 2.0));
+        assert!(!looks_discontinuous(&with(1.0, 1.5), 2.0));
+        assert!(!looks_discontinuous(&with(1.0, 2.0), 2.0));
+    }
 }
