@@ -14,9 +14,9 @@ pub fn fit_slope(xy: &[(f64, f64)]) -> Option<f64> {
         return None;
     }
     let mx = xy.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = xy.iter().map(|p| p.1).sum::<f64>() / n;
     let sxx: f64 = xy.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = xy.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    // The centred x sum to zero, so y needs no centring.
+    let sxy: f64 = xy.iter().map(|p| (p.0 - mx) * p.1).sum();
     (sxx > 0.0).then(|| sxy / sxx)
 }
 
@@ -183,5 +183,40 @@ mod tests {
         assert_eq!((k[0].0, k[0].1), (4, 16));
         assert!((k[0].2 + 1.0).abs() < 1e-12);
         assert!((k[1].2 + 1.5).abs() < 1e-12);
+    }
+
+    /// Type-7 quantiles by hand: h = (n - 1) q, then linear interpolation.
+    #[test]
+    fn quantiles_interpolate_between_order_statistics() {
+        let x = [10.0, 20.0, 30.0, 70.0];
+        assert_eq!(quantile(&x, 0.0), 10.0);
+        assert_eq!(quantile(&x, 1.0), 70.0);
+        // h = 0.3: 10 + 0.3 (20 - 10)
+        assert!((quantile(&x, 0.1) - 13.0).abs() < 1e-12);
+        // h = 2.55: 30 + 0.55 (70 - 30)
+        assert!((quantile(&x, 0.85) - 52.0).abs() < 1e-12);
+    }
+
+    /// Seeds that all agree leave nothing to resample: the interval is the slope itself,
+    /// whatever the size of the errors; a count whose errors are all 0 is left out of every
+    /// fit rather than making it infinite.
+    #[test]
+    fn bootstrap_of_identical_seeds_is_the_exact_slope() {
+        let at = |spp: u32, e: f64| SeedErrors {
+            spp,
+            errors: vec![e; 4],
+        };
+        let pts = [at(1, 640.0), at(4, 160.0), at(16, 40.0)];
+        let (lo, hi) = bootstrap_slope(&pts, 50).unwrap();
+        assert!(
+            (lo + 1.0).abs() < 1e-12 && (hi + 1.0).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        let with_zero = [at(1, 640.0), at(4, 160.0), at(16, 40.0), at(64, 0.0)];
+        let (lo, hi) = bootstrap_slope(&with_zero, 50).unwrap();
+        assert!(
+            (lo + 1.0).abs() < 1e-12 && (hi + 1.0).abs() < 1e-12,
+            "{lo} {hi}"
+        );
     }
 }

@@ -228,4 +228,27 @@ mod tests {
         assert!(close(sidak(0.01, 5), 0.002_008_048_34, 1e-11));
         assert!(sidak(0.01, 1000) > 0.01 / 1000.0);
     }
+
+    /// Degenerate inputs: NaN or non-positive dof give a NaN p-value; a constant estimate is
+    /// certainly off by the sign of its difference; Welch with both variances zero reports
+    /// the pooled dof n_a + n_b - 2.
+    #[test]
+    fn degenerate_inputs() {
+        assert!(two_sided_p(f64::NAN, 5.0).is_nan());
+        assert!(two_sided_p(1.0, f64::NAN).is_nan());
+        assert!(two_sided_p(1.0, 0.0).is_nan());
+        assert!(two_sided_p(1.0, -2.0).is_nan());
+        assert_eq!(two_sided_p(f64::INFINITY, 3.0), 0.0);
+        let below = one_sample(1.0, 0.0, 10, 2.0);
+        assert_eq!((below.t, below.p_value), (f64::NEG_INFINITY, 0.0));
+        let above = one_sample(3.0, 0.0, 10, 2.0);
+        assert_eq!((above.t, above.p_value), (f64::INFINITY, 0.0));
+        let g = |mean: f64, n: u64| Group {
+            mean,
+            variance: 0.0,
+            n,
+        };
+        let w = welch(g(1.0, 5), g(1.0, 7));
+        assert_eq!((w.t, w.dof, w.p_value), (0.0, 10.0, 1.0));
+    }
 }
