@@ -143,4 +143,14 @@ mod tests {
         w.push(4.0);
         assert_eq!((w.mean(), w.variance()), (4.0, 0.0));
     }
+
+    /// Two samples are enough for a variance: (1, 3) has mean 2 and variance 2.
+    #[test]
+    fn two_samples_have_a_variance() {
+        let mut w = Welford::default();
+        w.push(1.0);
+        assert_eq!(w.variance(), 0.0);
+        w.push(3.0);
+        assert_eq!((w.mean(), w.variance()), (2.0, 2.0));
+    }
 }
