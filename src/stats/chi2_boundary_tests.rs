@@ -162,6 +162,7 @@ fn boundary_pass_finds_a_tip_between_the_first_nodes() {
             "tip cell ({tc}, {tr}), transposed {transposed}: {got} vs {}",
             exact(tc, tr)
         );
+        let (mut untouched, mut inside) = (0, 0);
         for r in 0..N {
             for c in 0..N {
                 let (g, e) = (looked.grid.get(c, r), exact(c, r));
@@ -169,14 +170,17 @@ fn boundary_pass_finds_a_tip_between_the_first_nodes() {
                     (g - e).abs() <= 2e-4 + 0.02 * e,
                     "cell ({c}, {r}), transposed {transposed}: {g} vs {e}"
                 );
-                // Cells whose whole neighbourhood is inside or outside the support are
-                // not looked at again: the same evaluations in both runs.
-                let nb = (r.saturating_sub(1)..=(r + 1).min(N - 1)).flat_map(|rr| {
-                    (c.saturating_sub(1)..=(c + 1).min(N - 1)).map(move |cc| exact(cc, rr))
-                });
-                let cell_area = 1.0 / (N * N) as f64;
-                let all: Vec<f64> = nb.map(|x| x / (density * cell_area)).collect();
-                if all.iter().all(|&x| x == 0.0) || all.iter().all(|&x| x == 1.0) {
+                // Cells whose whole neighbourhood the first pass found empty, or found
+                // non-empty, are not looked at again: the same evaluations in both runs.
+                let first = &plain.grid;
+                let all: Vec<f64> = (r.saturating_sub(1)..=(r + 1).min(N - 1))
+                    .flat_map(|rr| {
+                        (c.saturating_sub(1)..=(c + 1).min(N - 1)).map(move |cc| first.get(cc, rr))
+                    })
+                    .collect();
+                if all.iter().all(|&x| x == 0.0) || all.iter().all(|&x| x > 0.0) {
+                    untouched += 1;
+                    inside += usize::from(all[0] > 0.0);
                     assert_eq!(
                         evaluations_in(&plain.points, c, r),
                         evaluations_in(&looked.points, c, r),
@@ -185,6 +189,10 @@ fn boundary_pass_finds_a_tip_between_the_first_nodes() {
                 }
             }
         }
+        assert!(
+            untouched >= 20 && inside >= 4,
+            "{untouched} cells checked, {inside} inside"
+        );
         // The boundary pass starts finer but stops at the first pass's finest scale:
         // nodes 1/(cells * initial_split * 2^max_depth * 4) apart.
         let axis = usize::from(transposed);

@@ -445,8 +445,21 @@ fn negative_or_nan_pdf_values_fail_with_their_count() {
             .parse()
             .unwrap();
         assert!(count > 0, "{why}");
-        let (grid, n) = cell_integrals_seen(&square(), pdf, &Integration::default(), None);
-        assert!(n > 0, "{bad}");
+        // The count is exactly the number of bad evaluations.
+        let seen_bad = std::cell::Cell::new(0u64);
+        let counting = |p: Vec2| {
+            let x = pdf(p);
+            if !(x >= 0.0) {
+                seen_bad.set(seen_bad.get() + 1);
+            }
+            x
+        };
+        let (grid, n) = cell_integrals_seen(&square(), counting, &Integration::default(), None);
+        assert!(
+            n > 0 && n == seen_bad.get(),
+            "{bad}: {n} vs {}",
+            seen_bad.get()
+        );
         assert!(grid.data.iter().all(|x| *x >= 0.0 && x.is_finite()));
         // Columns past x = 0.9 lose their mass: the total is about 0.9.
         let total: f64 = grid.data.iter().sum();
