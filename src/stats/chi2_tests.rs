@@ -213,6 +213,24 @@ fn outside_domain_fails() {
     );
     assert!(!r.passed());
     assert!(r.reason.contains("not unit length"), "{}", r.reason);
+    assert_eq!(r.outside, N, "every sample is counted outside");
+    // One stray sample in three is counted as such.
+    let mut k = 0u64;
+    let r = chi2_test(
+        &Sphere::default(),
+        |g| {
+            k += 1;
+            if k % 3 == 0 {
+                Some(Vec3::new(0.0, 0.0, 2.0))
+            } else {
+                cosine_hemisphere(g)
+            }
+        },
+        cosine_pdf,
+        &cfg(0.01),
+    );
+    assert!(!r.passed());
+    assert_eq!(r.outside, N / 3);
 }
 
 #[test]
