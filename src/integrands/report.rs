@@ -198,9 +198,12 @@ fn pixel_section(
          each its own), so unoccluded the light sample's integrand is smooth and in the \
          penumbra it has an edge. N = {} to {}, {seeds} seeds; error against the closed form \
          across seeds. Samplers that pad (`stratified`, `sobol:padded`) stratify the triangle \
-         choice and the point on the triangle separately: unoccluded, both triangles carry \
-         the same integral and that costs nothing, but in the penumbra the integrand depends \
-         on both jointly and only a joint set keeps a rate faster than Monte Carlo's.\n\n\
+         choice and the point on the triangle separately: unoccluded, this light's two \
+         triangles give the same value at the same point of their parametrisation, so the \
+         choice costs nothing, but in the penumbra the integrand depends on both jointly and \
+         only a joint set keeps a rate faster than Monte Carlo's (a triangulation without \
+         that symmetry, or a light of unequal triangles, costs padded draws their rate even \
+         unoccluded).\n\n\
          | case | strategy | sampler | slope, complete counts [95 % CI] | off-grid slope | RMSE at N = {} |\n\
          |---|---|---|---|---|---|",
         counts[0],

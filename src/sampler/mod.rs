@@ -257,6 +257,22 @@ pub trait Sampler {
     fn bsdf(&mut self) -> BsdfDims;
 }
 
+/// Whether the 2^m points are a (0, m, 2)-net: every 2^i x 2^(m-i) elementary box holds
+/// exactly one of them (tests of the Sobol' samplers).
+#[cfg(test)]
+pub(crate) fn is_02_net(points: &[(f32, f32)], m: u32) -> bool {
+    assert_eq!(points.len(), 1 << m);
+    (0..=m).all(|i| {
+        let (nx, ny) = (1u64 << i, 1u64 << (m - i));
+        let mut count = vec![0u32; 1 << m];
+        for &(x, y) in points {
+            let (bx, by) = ((x as f64 * nx as f64) as u64, (y as f64 * ny as f64) as u64);
+            count[(by * nx + bx) as usize] += 1;
+        }
+        count.iter().all(|&c| c == 1)
+    })
+}
+
 /// One camera sample's groups in allocation order, as the ten values they hold (tests).
 #[cfg(test)]
 pub(crate) fn all_values(s: &mut impl Sampler) -> [f32; 10] {

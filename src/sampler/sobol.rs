@@ -176,7 +176,7 @@ mod tests {
     use super::*;
     use crate::rng::LANES;
     use crate::sampler::pure::PureSample;
-    use crate::sampler::{DimAlloc, Sampler, SamplerLanes};
+    use crate::sampler::{is_02_net, DimAlloc, Sampler, SamplerLanes};
 
     fn cfg(seed: u64, dims: DimAlloc) -> SamplerConfig {
         SamplerConfig {
@@ -202,19 +202,6 @@ mod tests {
                 (f.x, f.y)
             })
             .collect()
-    }
-
-    /// Every 2^i x 2^(m-i) elementary box holds exactly one of the 2^m points.
-    fn is_02_net(points: &[(f32, f32)], m: u32) -> bool {
-        (0..=m).all(|i| {
-            let (nx, ny) = (1u64 << i, 1u64 << (m - i));
-            let mut count = vec![0u32; 1 << m];
-            for &(x, y) in points {
-                let (bx, by) = ((x as f64 * nx as f64) as u64, (y as f64 * ny as f64) as u64);
-                count[(by * nx + bx) as usize] += 1;
-            }
-            count.iter().all(|&c| c == 1)
-        })
     }
 
     #[test]

@@ -1,6 +1,6 @@
 use super::*;
 use crate::sampler::pure::PureSample;
-use crate::sampler::{DimAlloc, Sampler, SamplerLanes, Sampling};
+use crate::sampler::{is_02_net, DimAlloc, Sampler, SamplerLanes, Sampling};
 use sobol_burley::parts::sobol_int4_rev;
 
 fn cfg(seed: u64, run_samples: u64, (width, height): (u32, u32)) -> SamplerConfig {
@@ -11,20 +11,6 @@ fn cfg(seed: u64, run_samples: u64, (width, height): (u32, u32)) -> SamplerConfi
         width,
         height,
     }
-}
-
-/// Every 2^i x 2^(m-i) elementary box holds exactly one of the 2^m points.
-fn is_02_net(points: &[(f32, f32)], m: u32) -> bool {
-    assert_eq!(points.len(), 1 << m);
-    (0..=m).all(|i| {
-        let (nx, ny) = (1u64 << i, 1u64 << (m - i));
-        let mut count = vec![0u32; 1 << m];
-        for &(x, y) in points {
-            let (bx, by) = ((x as f64 * nx as f64) as u64, (y as f64 * ny as f64) as u64);
-            count[(by * nx + bx) as usize] += 1;
-        }
-        count.iter().all(|&c| c == 1)
-    })
 }
 
 fn film(px: ZPixel, s: u64) -> (f32, f32) {

@@ -126,6 +126,21 @@ fn cell_of(c: usize, r: usize) -> ([f64; 2], [f64; 2]) {
     )
 }
 
+/// The smallest spacing between the distinct coordinates (`axis` 0: u, 1: v) of the
+/// evaluations strictly inside cell (c, r): the finest scale the integration reached.
+fn finest_spacing(points: &[[f64; 2]], c: usize, r: usize, axis: usize) -> f64 {
+    let mut along: Vec<f64> = evaluations_in(points, c, r)
+        .iter()
+        .map(|p| p[axis])
+        .collect();
+    along.sort_by(f64::total_cmp);
+    along.dedup();
+    along
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Evaluations strictly inside cell (c, r) (nodes on its edges are shared with neighbours).
 fn evaluations_in(points: &[[f64; 2]], c: usize, r: usize) -> Vec<[f64; 2]> {
     let (u, v) = cell_of(c, r);
@@ -195,17 +210,7 @@ fn boundary_pass_finds_a_tip_between_the_first_nodes() {
         );
         // The boundary pass starts finer but stops at the first pass's finest scale:
         // nodes 1/(cells * initial_split * 2^max_depth * 4) apart.
-        let axis = usize::from(transposed);
-        let mut along: Vec<f64> = evaluations_in(&looked.points, tc, tr)
-            .iter()
-            .map(|p| p[axis])
-            .collect();
-        along.sort_by(f64::total_cmp);
-        along.dedup();
-        let finest = along
-            .windows(2)
-            .map(|w| w[1] - w[0])
-            .fold(f64::INFINITY, f64::min);
+        let finest = finest_spacing(&looked.points, tc, tr, usize::from(transposed));
         assert_eq!(
             finest,
             1.0 / (N * 2 * 64 * 4) as f64,
@@ -335,16 +340,7 @@ fn observed_samples_recheck_empty_cells() {
         }
     }
     // 16 x 16 start rectangles and max_depth 6 - 3 levels: the first pass's finest scale.
-    let mut along: Vec<f64> = evaluations_in(&looked.points, 0, 4)
-        .iter()
-        .map(|p| p[0])
-        .collect();
-    along.sort_by(f64::total_cmp);
-    along.dedup();
-    let finest = along
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .fold(f64::INFINITY, f64::min);
+    let finest = finest_spacing(&looked.points, 0, 4, 0);
     assert_eq!(finest, 1.0 / (N * 2 * 64 * 4) as f64);
     // Without the samples (or with recheck off) the tip stays empty.
     let off = Integration {

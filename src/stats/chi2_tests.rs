@@ -220,7 +220,7 @@ fn outside_domain_fails() {
         &Sphere::default(),
         |g| {
             k += 1;
-            if k % 3 == 0 {
+            if k.is_multiple_of(3) {
                 Some(Vec3::new(0.0, 0.0, 2.0))
             } else {
                 cosine_hemisphere(g)
