@@ -198,11 +198,18 @@ fn lane_samples_are_bitwise_the_per_sample_definition() {
 }
 
 /// The strategies the lanes cover: multi-sample MIS with one sample per technique and area
-/// sampling, with either heuristic, either emitter choice, emitters shown or hidden.
+/// sampling, with either heuristic, every emitter choice but RIS over several candidates,
+/// emitters shown or hidden.
 fn lane_strategies() -> Vec<Strategy> {
     let mut v = Vec::new();
     for heuristic in [Heuristic::Balance, Heuristic::Power] {
-        for selection in [EmitterSelection::Uniform, EmitterSelection::Power] {
+        for selection in [
+            EmitterSelection::Uniform,
+            EmitterSelection::Power,
+            EmitterSelection::Exhaustive,
+            EmitterSelection::Bvh,
+            EmitterSelection::Ris(1),
+        ] {
             for hide_emitters in [false, true] {
                 v.push(Strategy {
                     kind: StrategyKind::Mis,
@@ -314,6 +321,9 @@ fn random_scenes_render_bitwise_as_their_per_sample_definition() {
         "heuristic Power".into(),
         "selection Uniform".into(),
         "selection Power".into(),
+        "selection Exhaustive".into(),
+        "selection Bvh".into(),
+        "selection Ris(1)".into(),
         "hide_emitters true".into(),
         "hide_emitters false".into(),
         "smooth receiver".into(),

@@ -78,7 +78,7 @@ fn lanes(rays: &RayPacket, mask: u32) -> impl Iterator<Item = Ray> + '_ {
 /// The ray mix of `spp` samples per pixel of the scene's camera, emitters chosen by `selection`.
 pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
     let cam = &scene.camera;
-    let selector = EmitterSelector::new(&scene.emitters, selection);
+    let selector = EmitterSelector::new(&scene.emitters, &scene.shapes, selection);
     let mut mix = RayMix {
         packets: Vec::new(),
         bsdf: Vec::new(),
@@ -112,7 +112,7 @@ pub fn ray_mix(scene: &Scene, spp: u32, selection: EmitterSelection) -> RayMix {
                 let frame = Frame::from_normal(sp.ns);
                 let wi = frame.to_local(-ray.d);
                 let mat = scene.material(&sp);
-                let e = selector.sample(rng.next_f32());
+                let e = selector.sample(sp.p, sp.ns, rng.next_f32());
                 let (u_prim, u) = (rng.next_f32(), rng.next_2d());
                 if let Some(ls) = e.and_then(|(e, _)| {
                     scene.emitters[e].sample(&scene.shapes, sp.p, u_prim, u, LightSampling::Area)

@@ -88,7 +88,7 @@ pub(super) fn section(
         // more triangles), which is not the selector's doing.
         let selectors: Vec<_> = scenes
             .iter()
-            .map(|scene| crate::emitter::EmitterSelector::new(&scene.emitters, sel))
+            .map(|scene| crate::emitter::EmitterSelector::new(&scene.emitters, &scene.shapes, sel))
             .collect();
         for (n, ns) in counts.into_iter().zip(choice_ns(&selectors)) {
             println!(
@@ -170,7 +170,11 @@ fn choice_run_ns(selector: &crate::emitter::EmitterSelector) -> f64 {
     let mut sink = 0usize;
     for i in 0..n {
         let u = std::hint::black_box((i as f64 * 0.618_033_988_749_895).fract() as f32);
-        if let Some((e, pmf)) = selector.sample(u) {
+        // Shading points spread over the lights' floor (the point-independent rules
+        // ignore them).
+        let v = (i as f64 * 0.754_877_666_246_693).fract() as f32;
+        let p = glam::Vec3::new(6.0 * u - 3.0, 6.0 * v - 3.0, 0.0);
+        if let Some((e, pmf)) = selector.sample(p, glam::Vec3::Z, u) {
             sink = sink.wrapping_add(e).wrapping_add(pmf.to_bits() as usize);
         }
     }

@@ -130,10 +130,11 @@ fn emitter_choice(selection: EmitterSelection) -> Case {
                 })
                 .collect(),
         ),
+        other => unreachable!("{other}: the choice here is the same at every point"),
     };
     let name = format!("discrete/emitter-choice-{label}");
     let pmf = normalised(&weights);
-    let selector = EmitterSelector::new(&scene.emitters, selection);
+    let selector = EmitterSelector::new(&scene.emitters, &scene.shapes, selection);
     Case::new(
         name.clone(),
         format!("EmitterSelector ({label}) over the five-light scene"),
@@ -141,7 +142,11 @@ fn emitter_choice(selection: EmitterSelection) -> Case {
             discrete_test(
                 &name,
                 &pmf,
-                |r| selector.sample(r.next_f32()).map_or(usize::MAX, |s| s.0),
+                |r| {
+                    selector
+                        .sample(glam::Vec3::ZERO, glam::Vec3::ZERO, r.next_f32())
+                        .map_or(usize::MAX, |s| s.0)
+                },
                 cfg,
             )
         },

@@ -228,10 +228,7 @@ pub fn cases() -> Vec<Case> {
     }
     let scene = build(scene_lights());
     for selection in [EmitterSelection::Uniform, EmitterSelection::Power] {
-        let sel = match selection {
-            EmitterSelection::Uniform => "uniform",
-            EmitterSelection::Power => "power",
-        };
+        let sel = selection.name();
         for mode in modes {
             let name = format!("emitter/scene-{sel}-{}", mode_name(mode));
             let about = format!(

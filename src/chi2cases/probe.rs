@@ -20,6 +20,8 @@ pub struct LightProbe {
     pub scene: Arc<Scene>,
     pub selector: EmitterSelector,
     pub ref_p: Vec3,
+    /// The receiver's normal the point-dependent emitter choices see (zero: none).
+    pub normal: Vec3,
     pub mode: LightSampling,
 }
 
@@ -63,11 +65,12 @@ impl LightProbe {
         ref_p: Vec3,
         mode: LightSampling,
     ) -> Self {
-        let selector = EmitterSelector::new(&scene.emitters, selection);
+        let selector = EmitterSelector::new(&scene.emitters, &scene.shapes, selection);
         LightProbe {
             scene,
             selector,
             ref_p,
+            normal: Vec3::ZERO,
             mode,
         }
     }
@@ -75,7 +78,9 @@ impl LightProbe {
     /// One light sample's direction, drawing random numbers in the integrator's order:
     /// emitter, triangle, point.
     pub fn sample(&self, rng: &mut Rng) -> Option<Vec3> {
-        let (ei, _) = self.selector.sample(rng.next_f32())?;
+        let (ei, _) = self
+            .selector
+            .sample(self.ref_p, self.normal, rng.next_f32())?;
         let u_prim = rng.next_f32();
         let u = rng.next_2d();
         let s = &self.scene;
@@ -91,7 +96,7 @@ impl LightProbe {
         for (si, shape) in s.shapes.iter().enumerate() {
             let Some(ei) = shape.emitter else { continue };
             let e: &Emitter = &s.emitters[ei as usize];
-            let pmf = self.selector.pmf(ei as usize) as f64;
+            let pmf = self.selector.pmf(self.ref_p, self.normal, ei as usize) as f64;
             crossings(s, si, self.ref_p, d, |sp| {
                 total += pmf * e.pdf(&s.shapes, self.ref_p, &sp, self.mode) as f64;
             });

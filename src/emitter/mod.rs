@@ -1,11 +1,14 @@
 //! Emitters (one-sided diffuse area lights, point lights) and the choice among them.
 
 mod area;
+mod bounds;
 mod select;
+mod tree;
 
 pub use area::AreaLight;
 pub(crate) use area::{area_pdf_along, sample_at, sphere_area_point};
-pub use select::{EmitterSelection, EmitterSelector};
+pub use bounds::{Cone, LightBounds};
+pub use select::{EmitterSelection, EmitterSelector, RIS_MAX};
 
 use crate::geometry::{Shape, SurfacePoint};
 use crate::math::{luminance, Rgb, PI};

@@ -92,6 +92,10 @@ fn effective(s: &Strategy, t: &SceneTraits) -> Result<(Strategy, Vec<String>), S
         }
         _ => {}
     }
+    if e.selection == EmitterSelection::Ris(1) {
+        e.selection = EmitterSelection::Power;
+        why.push("ris:1 keeps its only candidate, drawn by power: power choice".into());
+    }
     if e.selection == EmitterSelection::Power {
         if t.emitters == 1 {
             e.selection = EmitterSelection::Uniform;

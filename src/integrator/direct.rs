@@ -13,7 +13,7 @@ use super::Strategy;
 use crate::bsdf::{BsdfSample, Material};
 use crate::emitter::{EmitterSelector, LightSample};
 use crate::geometry::{Hit, Ray, SurfacePoint};
-use crate::math::{Frame, Rgb};
+use crate::math::{luminance, Frame, Rgb};
 use crate::sampler::Sampler;
 use crate::scene::desc::{Heuristic, StrategyKind};
 use crate::scene::Scene;
@@ -24,6 +24,20 @@ pub struct Direct<'a> {
     pub strategy: Strategy,
     pub(super) selector: EmitterSelector,
     has_delta_lights: bool,
+    /// RIS's candidate count, if it is above 1 (`ris:1` is its source strategy, power).
+    ris: Option<u32>,
+}
+
+/// A light sample drawn: the point, its emitter's choice pmf and the density the estimate
+/// divides by (pmf * pdf, or RIS's 1 / W). MIS weights use pmf * pdf in every case: for RIS
+/// that is the density of its candidates, which BSDF-sampled hits also use (any density
+/// both techniques compute alike keeps the weights a partition of unity, and the RIS
+/// estimate f W stays unbiased for every weighted integrand).
+#[derive(Clone, Copy)]
+pub(super) struct LightDraw {
+    ls: LightSample,
+    pmf: f32,
+    p_div: f32,
 }
 
 #[inline]
@@ -49,12 +63,13 @@ struct Shading<'m> {
 
 impl<'a> Direct<'a> {
     pub fn new(scene: &'a Scene, strategy: Strategy) -> Self {
-        let selector = EmitterSelector::new(&scene.emitters, strategy.selection);
+        let selector = EmitterSelector::new(&scene.emitters, &scene.shapes, strategy.selection);
         Direct {
             scene,
             strategy,
             has_delta_lights: scene.emitters.iter().any(|e| e.is_delta()),
             selector,
+            ris: strategy.selection.ris().filter(|&m| m > 1),
         }
     }
 
@@ -177,10 +192,24 @@ impl<'a> Direct<'a> {
 
     /// The random half of a light sample: the emitter, its point and density.
     #[inline(always)]
-    fn light_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<(LightSample, f32)> {
+    fn light_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<LightDraw> {
+        if let Some(m) = self.ris {
+            return self.ris_draw(sh, rng, m);
+        }
+        let (ls, pmf) = self.candidate(sh, rng)?;
+        Some(LightDraw {
+            ls,
+            pmf,
+            p_div: pmf * ls.pdf,
+        })
+    }
+
+    /// An emitter chosen at the shading point and a point drawn on it.
+    #[inline(always)]
+    fn candidate(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<(LightSample, f32)> {
         let scene = self.scene;
         let u = rng.light();
-        let (ei, pmf) = self.selector.sample(u.select)?;
+        let (ei, pmf) = self.selector.sample(sh.sp.p, sh.sp.ns, u.select)?;
         let ls = scene.emitters[ei].sample(
             &scene.shapes,
             sh.sp.p,
@@ -191,15 +220,54 @@ impl<'a> Direct<'a> {
         Some((ls, pmf))
     }
 
+    /// Resampled importance sampling (Talbot 2005; Bitterli et al. 2020's weight): `m`
+    /// candidates drawn by power, one kept with probability proportional to
+    /// w = p_hat / (pmf * pdf), where p_hat is the luminance of its unshadowed contribution;
+    /// the estimate divides by m p_hat / sum(w). One number chooses (drawn first, with the
+    /// technique's dimension), rescaled after each candidate as a reservoir of one; each
+    /// candidate takes a light sample's numbers whether it is kept or not.
+    #[inline(never)]
+    fn ris_draw(&self, sh: &Shading, rng: &mut impl Sampler, m: u32) -> Option<LightDraw> {
+        const BELOW_ONE: f64 = 1.0 - f64::EPSILON / 2.0;
+        let mut u = rng.technique() as f64;
+        let mut w_sum = 0.0f64;
+        let mut kept: Option<(LightSample, f32, f32)> = None;
+        for _ in 0..m {
+            let Some((ls, pmf)) = self.candidate(sh, rng) else {
+                continue;
+            };
+            let (f, _) = sh.mat.eval_pdf(sh.wi, sh.frame.to_local(ls.wi));
+            let p_hat = luminance(f * ls.li);
+            let w = p_hat as f64 / (pmf as f64 * ls.pdf as f64);
+            if !(p_hat > 0.0 && w.is_finite()) {
+                continue;
+            }
+            w_sum += w;
+            let q = w / w_sum;
+            if u < q {
+                u = (u / q).min(BELOW_ONE);
+                kept = Some((ls, pmf, p_hat));
+            } else {
+                u = ((u - q) / (1.0 - q)).min(BELOW_ONE);
+            }
+        }
+        let (ls, pmf, p_hat) = kept?;
+        Some(LightDraw {
+            ls,
+            pmf,
+            p_div: (m as f64 * p_hat as f64 / w_sum) as f32,
+        })
+    }
+
     /// The rest of a light sample: BSDF, visibility and weight.
     #[inline(always)]
     fn light_finish(
         &self,
         sh: &Shading,
-        drawn: Option<(LightSample, f32)>,
+        drawn: Option<LightDraw>,
         weight: impl Fn(f32, f32) -> f32,
     ) -> Rgb {
-        let Some((ls, pmf)) = drawn else {
+        let Some(LightDraw { ls, pmf, p_div }) = drawn else {
             return Rgb::ZERO;
         };
         let wo = sh.frame.to_local(ls.wi);
@@ -213,7 +281,7 @@ impl<'a> Direct<'a> {
         let p_light = pmf * ls.pdf;
         let p_bsdf = if ls.delta { 0.0 } else { pdf };
         let w = weight(p_light, p_bsdf);
-        f * ls.li * (w / p_light)
+        f * ls.li * (w / p_div)
     }
 
     /// One BSDF-technique sample: follow the sampled direction and collect emission there.
@@ -250,14 +318,14 @@ impl<'a> Direct<'a> {
         };
         let d = sh.frame.to_world(bs.wo);
         let (ray, emitter_skip) = scene.bsdf_ray(&sh.sp, d);
-        self.bsdf_arrive(sh.sp.p, &ray, emitter_skip, &bs, weight)
+        self.bsdf_arrive(&sh.sp, &ray, emitter_skip, &bs, weight)
     }
 
     /// A BSDF sample's ray from `from` traced: the emission it reaches, weighted.
     #[inline(always)]
     pub(super) fn bsdf_arrive(
         &self,
-        from: Vec3,
+        from: &SurfacePoint,
         ray: &Ray,
         emitter_skip: u32,
         bs: &BsdfSample,
@@ -273,7 +341,7 @@ impl<'a> Direct<'a> {
     #[inline(always)]
     pub(super) fn bsdf_emission(
         &self,
-        from: Vec3,
+        from: &SurfacePoint,
         d: Vec3,
         hit: &Hit,
         bs: &BsdfSample,
@@ -290,8 +358,8 @@ impl<'a> Direct<'a> {
         let p_light = if bs.delta {
             0.0
         } else {
-            self.selector.pmf(ei)
-                * e.pdf(&scene.shapes, from, &hit.sp, self.strategy.light_sampling)
+            self.selector.pmf(from.p, from.ns, ei)
+                * e.pdf(&scene.shapes, from.p, &hit.sp, self.strategy.light_sampling)
         };
         let w = weight(bs.pdf, p_light);
         bs.weight * le * w

@@ -13,4 +13,6 @@ pub use strategy::{Strategy, StrategyOverrides};
 #[cfg(test)]
 mod coated_tests;
 #[cfg(test)]
+mod many_lights_tests;
+#[cfg(test)]
 pub(crate) mod tests;

@@ -81,10 +81,7 @@ impl Strategy {
 
     /// Stable label for file names, CSV rows and plot legends, e.g. `mis-power-e1b1-uni-area`.
     pub fn label(&self) -> String {
-        let sel = match self.selection {
-            EmitterSelection::Uniform => "uni",
-            EmitterSelection::Power => "pow",
-        };
+        let sel = self.selection.short();
         let ls = match self.light_sampling {
             LightSampling::Area => "area",
             LightSampling::SolidAngle => "sa",
@@ -113,7 +110,8 @@ impl Strategy {
 pub struct StrategyOverrides {
     #[arg(long, value_enum)]
     pub strategy: Option<StrategyKind>,
-    #[arg(long, value_enum)]
+    /// uniform, power, exhaustive, bvh or ris:M.
+    #[arg(long)]
     pub emitter_selection: Option<EmitterSelection>,
     #[arg(long, value_enum)]
     pub light_sampling: Option<LightSampling>,

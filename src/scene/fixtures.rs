@@ -271,6 +271,52 @@ pub fn transform(desc: &mut SceneDesc, m: Mat4) {
     desc.camera.to_world = m * desc.camera.to_world;
 }
 
+/// A side x side grid of square lights in the plane z = `height`, facing down (-z), centred
+/// on the origin with centres `pitch` apart, each of half-size `half` and its own emitter;
+/// light (i, j) has radiance `radiance(i, j)`. Lights in one plane facing down cannot shadow
+/// one another for a point below them: over a floor, the exact answer is the sum of
+/// Lambert's formula over the lights (`analytic::polygon_irradiance`).
+pub fn light_grid(
+    side: usize,
+    pitch: f32,
+    half: f32,
+    height: f32,
+    radiance: impl Fn(usize, usize) -> f32,
+) -> Vec<ShapeDesc> {
+    let mut out = Vec::with_capacity(side * side);
+    let start = -0.5 * pitch * (side as f32 - 1.0);
+    for j in 0..side {
+        for i in 0..side {
+            let c = Vec3::new(start + pitch * i as f32, start + pitch * j as f32, height);
+            // This winding faces -z.
+            let v = vec![
+                c + Vec3::new(-half, -half, 0.0),
+                c + Vec3::new(-half, half, 0.0),
+                c + Vec3::new(half, half, 0.0),
+                c + Vec3::new(half, -half, 0.0),
+            ];
+            let l = Rgb::splat(radiance(i, j));
+            out.push(mesh(v, vec![[0, 1, 2], [0, 2, 3]], diffuse(0.0), Some(l)));
+        }
+    }
+    out
+}
+
+/// The quads of `light_grid`, as polygons for Lambert's formula (counter-clockwise seen
+/// from below), with their radiances.
+pub fn light_grid_polygons(shapes: &[ShapeDesc]) -> Vec<(Vec<glam::DVec3>, f64)> {
+    shapes
+        .iter()
+        .filter_map(|s| {
+            let ShapeGeometry::Mesh { positions, .. } = &s.geometry else {
+                return None;
+            };
+            let l = s.emitter.as_ref()?.radiance.x as f64;
+            Some((positions.iter().map(|p| p.as_dvec3()).collect(), l))
+        })
+        .collect()
+}
+
 /// Just these shapes (and a 1x1 camera that nothing depends on): for testing light sampling
 /// on its own, where no receiver or floor should be in the way.
 pub fn shapes_only(shapes: Vec<ShapeDesc>) -> SceneDesc {

@@ -7,7 +7,7 @@
 use super::tables::{LaneLight, LaneLightKind, LightTriangle, SmallLights, SmallMesh};
 use crate::emitter::{area_pdf_along, sample_at, sphere_area_point, EmitterSelector};
 use crate::geometry::ray_packet::bits;
-use crate::geometry::{lookup8, Mesh, Sphere, SurfacePoint};
+use crate::geometry::{lookup8, Mesh, PacketHits, Sphere, SurfacePoint};
 use crate::math::{Rgb, V3x8};
 use crate::rng::LANES;
 use crate::sampling::warps::square_to_uniform_triangle;
@@ -139,12 +139,14 @@ impl LightDraws {
     /// Emitter and triangle choice with `selector` and the triangle's data: the table lookups
     /// of `Direct::light_draw`.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)] // the lanes' arrays, each its own argument (see `shade_batch`)
     pub(super) fn draw(
         selector: &EmitterSelector,
         lights: &[LaneLight],
         small: Option<&SmallLights>,
         u_emitter: &[f32; LANES],
         u_tri: &[f32; LANES],
+        at: &PacketHits,
         d: &mut LightDraws,
         spheres: &mut SphereDraws,
     ) {
@@ -179,7 +181,10 @@ impl LightDraws {
             return d.small_lights(t, lights, u_emitter, u_tri, spheres);
         }
         for i in 0..LANES {
-            let Some((e, pmf)) = selector.sample(u_emitter[i]) else {
+            // The shading point matters to the point-dependent choices (a lane without a
+            // hit draws from garbage and is dropped).
+            let sp = at.point(i);
+            let Some((e, pmf)) = selector.sample(sp.p, sp.ns, u_emitter[i]) else {
                 continue;
             };
             let light = &lights[e];
@@ -363,12 +368,22 @@ mod tests {
                     let mut u = || std::array::from_fn(|_| rng.next_f32());
                     (u(), u())
                 }));
+                let hits = crate::geometry::PacketHits::default();
                 for (u_e, u_t) in batches {
                     let (mut a, mut b) = (LightDraws::default(), LightDraws::default());
                     let (mut sa, mut sb) = (SphereDraws::default(), SphereDraws::default());
                     let lights = &lanes.lights;
-                    LightDraws::draw(selector, lights, None, &u_e, &u_t, &mut a, &mut sa);
-                    LightDraws::draw(selector, lights, Some(small), &u_e, &u_t, &mut b, &mut sb);
+                    LightDraws::draw(selector, lights, None, &u_e, &u_t, &hits, &mut a, &mut sa);
+                    LightDraws::draw(
+                        selector,
+                        lights,
+                        Some(small),
+                        &u_e,
+                        &u_t,
+                        &hits,
+                        &mut b,
+                        &mut sb,
+                    );
                     assert_eq!(a.shape, b.shape, "u {u_e:?}");
                     assert_eq!(a.pmf.map(f32::to_bits), b.pmf.map(f32::to_bits));
                     assert_eq!(a.area.map(f32::to_bits), b.area.map(f32::to_bits));

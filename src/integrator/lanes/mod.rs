@@ -170,6 +170,7 @@ impl<'a> LaneKernel<'a> {
             small,
             &u[0],
             &u[1],
+            &hits.camera,
             draws,
             &mut spheres,
         );

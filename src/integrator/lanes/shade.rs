@@ -174,8 +174,8 @@ impl LaneKernel<'_> {
                     pdf: sh.bsdf_pdf[i],
                     delta: sh.bsdf_delta[i],
                 };
-                let from = h.camera.point(i).p;
-                bsdf.set(i, direct.bsdf_emission(from, ray.d, &hit, &bs, bsdf_w));
+                let from = h.camera.point(i);
+                bsdf.set(i, direct.bsdf_emission(&from, ray.d, &hit, &bs, bsdf_w));
             }
         }
         // `li`'s sum, in its order, for all lanes at once; only covered lanes are kept.

@@ -202,7 +202,8 @@ pub(super) struct SmallLights {
 
 impl SmallLights {
     pub(super) fn new(lights: &[LaneLight], selector: &EmitterSelector) -> Option<Self> {
-        if !(2..=8).contains(&lights.len()) || selector.len() != lights.len() {
+        let fits = (2..=8).contains(&lights.len()) && selector.len() == lights.len();
+        if !fits || !selector.point_independent() {
             return None;
         }
         let mut t = SmallLights {
@@ -215,7 +216,7 @@ impl SmallLights {
             meshes: 0,
         };
         for (e, light) in lights.iter().enumerate() {
-            t.pmf[e] = selector.pmf(e);
+            t.pmf[e] = selector.pmf(Vec3::ZERO, Vec3::ZERO, e);
             (t.shape[e], t.area[e]) = (f32::from_bits(light.shape), light.area);
             for (c, r) in light.radiance.to_array().into_iter().enumerate() {
                 t.radiance[c][e] = r;
@@ -274,7 +275,9 @@ pub(super) fn lane_setup<'a>(
 /// The lane lights, one per emitter, if the scene and strategy are the configuration the
 /// lanes cover.
 fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>> {
+    // RIS (above one candidate) draws a varying count of light samples: not in lanes.
     let covered = s.kind == StrategyKind::Mis
+        && s.selection.ris().is_none_or(|m| m == 1)
         && (s.emitter_samples, s.bsdf_samples) == SAMPLE_COUNTS
         && s.light_sampling == LightSampling::Area
         && !scene.emitters.is_empty();
@@ -339,7 +342,7 @@ mod tests {
             let lanes = lane_setup(
                 &scene,
                 &mis(),
-                &EmitterSelector::new(&scene.emitters, mis().selection),
+                &EmitterSelector::new(&scene.emitters, &scene.shapes, mis().selection),
             )
             .expect("covered");
             assert_eq!(lanes.shapes.len(), scene.shapes.len());
@@ -410,7 +413,7 @@ mod tests {
         let lanes = lane_setup(
             &scene,
             &mis(),
-            &EmitterSelector::new(&scene.emitters, mis().selection),
+            &EmitterSelector::new(&scene.emitters, &scene.shapes, mis().selection),
         )
         .expect("covered");
         let mut checked = 0;
