@@ -135,10 +135,19 @@ fn cmd_extreme(a: &ExtremeArgs) -> Result<(), String> {
 
 fn cmd_reproduce(a: &ReproduceArgs) -> Result<(), String> {
     let dir = crate::experiment::experiments_dir()?;
-    let files: Vec<PathBuf> = ["fig1", "fig2", "fig3", "fig4", "fig4-veach"]
-        .iter()
-        .map(|n| dir.join(format!("{n}.toml")))
-        .collect();
+    let files: Vec<PathBuf> = [
+        "fig1",
+        "fig2",
+        "fig3",
+        "fig4",
+        "fig4-veach",
+        "fig5",
+        "fig5-cbox",
+        "fig5-tiles",
+    ]
+    .iter()
+    .map(|n| dir.join(format!("{n}.toml")))
+    .collect();
     let integrands = crate::integrands::report::IntegrandsArgs {
         quick: a.sweep.quick,
         out: a.sweep.out.clone(),

@@ -33,6 +33,8 @@ fn bench_writes_every_section() {
             "4",
             "--max-load-emitters",
             "1000",
+            "--max-choice-emitters",
+            "100",
         ])
         .arg("--out")
         .arg(&out));
@@ -58,6 +60,8 @@ fn bench_writes_every_section() {
         "cbox.xml: 16x16",
         "scene loading as the emitter count grows",
         "x the independent sampler's time per sample",
+        "emitter choice alone",
+        "tree: depth",
     ] {
         assert!(
             stdout.contains(printed),
@@ -130,9 +134,12 @@ fn check_rows(out: &std::path::Path) {
     assert_eq!(sections["scaling_triangles"], 2, "{sections:?}");
     // Growth over the sweep: best against best, and the median of paired ratios.
     assert_eq!(sections["scaling_triangles_growth"], 2, "{sections:?}");
-    // Two selectors (uniform, power) at 1 and 10 emitters.
-    assert_eq!(sections["scaling_emitters"], 4, "{sections:?}");
-    assert_eq!(sections["emitter_choice"], 4, "{sections:?}");
+    // Four emitter choices (uniform, power, bvh, ris:8) rendered at 1 and 10 emitters.
+    assert_eq!(sections["scaling_emitters"], 8, "{sections:?}");
+    // The choice alone: four rules x (choice, pmf) at 1, 10 and 100 emitters; the tree's
+    // build time, memory and depth at each.
+    assert_eq!(sections["emitter_choice"], 4 * 2 * 3, "{sections:?}");
+    assert_eq!(sections["light_tree"], 3 * 3, "{sections:?}");
     assert_eq!(sections["peak_memory"], 1, "{sections:?}");
     // Reading and building the scene of 1,000 emitters.
     assert_eq!(sections["load_xml"], 1, "{sections:?}");

@@ -7,6 +7,7 @@
 //! emitter counts grow (`sweeps`, over the scenes of `scaling`); scene loading as the emitter
 //! count grows (`load`); peak memory.
 
+mod choice;
 mod copies;
 mod load;
 mod raylimit;
@@ -55,6 +56,10 @@ pub struct BenchArgs {
     /// Largest emitter count of the emitter-scaling sweep (1, 10, ... up to this).
     #[arg(long, default_value_t = 10_000)]
     pub max_emitters: usize,
+    /// Largest emitter count of the emitter-choice sweep (1, 10, ... up to this): the cost of
+    /// one choice per rule, and the light tree's build time and memory.
+    #[arg(long, default_value_t = 100_000)]
+    pub max_choice_emitters: usize,
     /// Largest emitter count of the scene-loading sweep (1e3, 1e4, ... up to this; 0 leaves
     /// the sweep out). A million emitters is a 190 MB XML file and about 3 GB of memory.
     #[arg(long, default_value_t = 1_000_000)]

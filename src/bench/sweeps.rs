@@ -56,7 +56,12 @@ pub(super) fn section(
             });
         }
     }
-    for sel in [EmitterSelection::Uniform, EmitterSelection::Power] {
+    for sel in [
+        EmitterSelection::Uniform,
+        EmitterSelection::Power,
+        EmitterSelection::Bvh,
+        EmitterSelection::Ris(8),
+    ] {
         let s = Strategy {
             selection: sel,
             ..mis
@@ -65,7 +70,7 @@ pub(super) fn section(
             .into_iter()
             .filter(|&n| n <= a.max_emitters)
             .collect();
-        let (scenes, costs) = sweep(&counts, scaling::many_lights, s, a, max_threads)?;
+        let (_, costs) = sweep(&counts, scaling::many_lights, s, a, max_threads)?;
         for (&n, c) in counts.iter().zip(&costs) {
             let best = least(c);
             println!(
@@ -84,29 +89,8 @@ pub(super) fn section(
                 unit: "ns/sample",
             });
         }
-        // The choice alone: the render's cost above also grows with the BVH (n lights are 2n
-        // more triangles), which is not the selector's doing.
-        let selectors: Vec<_> = scenes
-            .iter()
-            .map(|scene| crate::emitter::EmitterSelector::new(&scene.emitters, &scene.shapes, sel))
-            .collect();
-        for (n, ns) in counts.into_iter().zip(choice_ns(&selectors)) {
-            println!(
-                "  {:>9} emitters ({:?} choice alone): {:>8.2} ns/choice",
-                n, sel, ns
-            );
-            rows.push(Row {
-                section: "emitter_choice",
-                scene: "floor under a grid of quad lights".into(),
-                strategy: format!("{sel:?}").to_lowercase(),
-                threads: 1,
-                n: n as u64,
-                value: ns,
-                unit: "ns/choice",
-            });
-        }
     }
-    Ok(())
+    super::choice::section(a, rows)
 }
 
 /// Each item's cost in each of `repeat` repetitions, the items taking turns within each
@@ -140,46 +124,6 @@ fn sweep(
         1e9 / throughput(scene, strategy, a.sweep_spp, threads, 1)
     });
     Ok((scenes, costs))
-}
-
-/// Nanoseconds per emitter choice (one uniform number in, emitter and pmf out) of each
-/// selector, best of 7 runs of 2^22 choices (10 ms each). The selectors take turns, run by
-/// run: timed one selector after another, all seven runs of a count fitted inside one slow
-/// spell of this VM, and in two bench runs one count read 2.0 ns where the others read 1.3
-/// (best of 3 once read 3.8 ns for a table that costs 2.4). The numbers jump around the unit
-/// interval (golden-ratio sequence) as a render's do, so table lookups are not sequential.
-fn choice_ns(selectors: &[crate::emitter::EmitterSelector]) -> Vec<f64> {
-    let mut best = vec![f64::INFINITY; selectors.len()];
-    for _ in 0..7 {
-        for (selector, best) in selectors.iter().zip(&mut best) {
-            *best = best.min(choice_run_ns(selector));
-        }
-    }
-    best
-}
-
-/// One run of 2^22 choices, on a copy of the selector made before the clock starts: a local
-/// whose address never escapes stays in registers across `black_box`, while behind the
-/// reference every choice reloaded it after the barrier (uniform 2.0 ns and power 4.7 ns,
-/// against 1.3 and 2.5-2.7 from the copy, back to back).
-#[inline(never)]
-fn choice_run_ns(selector: &crate::emitter::EmitterSelector) -> f64 {
-    let selector = selector.clone();
-    let n = 1u32 << 22;
-    let start = std::time::Instant::now();
-    let mut sink = 0usize;
-    for i in 0..n {
-        let u = std::hint::black_box((i as f64 * 0.618_033_988_749_895).fract() as f32);
-        // Shading points spread over the lights' floor (the point-independent rules
-        // ignore them).
-        let v = (i as f64 * 0.754_877_666_246_693).fract() as f32;
-        let p = glam::Vec3::new(6.0 * u - 3.0, 6.0 * v - 3.0, 0.0);
-        if let Some((e, pmf)) = selector.sample(p, glam::Vec3::Z, u) {
-            sink = sink.wrapping_add(e).wrapping_add(pmf.to_bits() as usize);
-        }
-    }
-    std::hint::black_box(sink);
-    start.elapsed().as_secs_f64() * 1e9 / n as f64
 }
 
 #[cfg(test)]

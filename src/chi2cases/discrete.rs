@@ -249,6 +249,53 @@ fn dielectric_lobes() -> Vec<Case> {
         .collect()
 }
 
+/// The shading-point-dependent choices (exhaustive, the light tree) over the five-light scene,
+/// at two shading points: their choices against their own pmfs, with a last bin for choosing
+/// nothing (the pmfs need not sum to 1).
+fn point_choices() -> Vec<Case> {
+    use glam::Vec3;
+    let points = [
+        ("origin-up", Vec3::ZERO, Vec3::Z),
+        ("off-centre", Vec3::new(0.3, -0.2, 0.1), Vec3::ZERO),
+    ];
+    let mut out = Vec::new();
+    for selection in [EmitterSelection::Exhaustive, EmitterSelection::Bvh] {
+        for (view, p, n) in points {
+            let scene = emitters::build(emitters::scene_lights());
+            let selector = EmitterSelector::new(&scene.emitters, &scene.shapes, selection);
+            let k = scene.emitters.len();
+            let mut pmf: Vec<f64> = (0..k).map(|i| selector.pmf(p, n, i) as f64).collect();
+            pmf.push(selector.none_probability(p, n));
+            // The pmfs are f32: their sum is 1 to about 1e-7 (the unit tests check 1e-6),
+            // which this test's sum check (for pmfs computed in f64) would take for an error.
+            let total: f64 = pmf.iter().sum();
+            assert!(
+                (total - 1.0).abs() < 1e-6,
+                "{}: pmfs sum to {total}",
+                selection.name()
+            );
+            pmf.iter_mut().for_each(|q| *q /= total);
+            let name = format!("discrete/emitter-choice-{}-{view}", selection.name());
+            out.push(Case::new(
+                name.clone(),
+                format!(
+                    "EmitterSelector ({}) over the five-light scene at {p} (normal {n}), a bin for none",
+                    selection.name()
+                ),
+                move |cfg| {
+                    discrete_test(
+                        &name,
+                        &pmf,
+                        |r| selector.sample(p, n, r.next_f32()).map_or(k, |s| s.0),
+                        cfg,
+                    )
+                },
+            ));
+        }
+    }
+    out
+}
+
 pub fn cases() -> Vec<Case> {
     let pmf = normalised(&ALIAS_WEIGHTS);
     let table = AliasTable::new(&ALIAS_WEIGHTS).expect("positive weights");
@@ -270,6 +317,7 @@ pub fn cases() -> Vec<Case> {
         triangle_choice(),
     ]
     .into_iter()
+    .chain(point_choices())
     .chain(dielectric_lobes())
     .collect()
 }

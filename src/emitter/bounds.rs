@@ -1,10 +1,11 @@
 //! Bounds of what an emitter (or a set of them) can send towards a point: a box, a cone of
 //! emission normals, and the power. `importance` is an upper-bound-like estimate of the
 //! contribution at a receiver, used by the shading-point-dependent emitter choices
-//! (`exhaustive`, and the light tree's nodes). The measure is pbrt-v4's
+//! (`exhaustive`, and the light tree's nodes). The measure follows pbrt-v4's
 //! (`LightBounds::Importance`), with its distance clamp fixed: pbrt compares the squared
 //! distance with the half diagonal's length, which makes the pmf change with the scene's unit;
 //! here both are squared lengths, so the importance of area lights does not depend on the unit.
+//! Its cosines are bounded over the box rather than its bounding sphere (see `importance`).
 
 use super::Emitter;
 use crate::geometry::{Shape, ShapeKind};
@@ -117,16 +118,6 @@ fn cos_sub_clamped(sin_a: f64, cos_a: f64, sin_b: f64, cos_b: f64) -> f64 {
     }
 }
 
-/// sin(max(0, a - b)).
-#[inline]
-fn sin_sub_clamped(sin_a: f64, cos_a: f64, sin_b: f64, cos_b: f64) -> f64 {
-    if cos_a > cos_b {
-        0.0
-    } else {
-        sin_a * cos_b - cos_a * sin_b
-    }
-}
-
 impl LightBounds {
     /// The bounds of emitter `e`, or None if it emits nothing (zero or non-finite power, or
     /// no triangle of positive area): such an emitter is never chosen.
@@ -193,41 +184,59 @@ impl LightBounds {
 
     /// An estimate of the contribution at point `p` with normal `n` (zero vector: no
     /// receiver cosine), which is 0 only where nothing inside the bounds can send light to
-    /// `p`: `p` outside every emission cone widened by the angle the box subtends, or `p`'s
-    /// tangent plane tangent to that widened cone. In f64: the sines recovered from cosines
-    /// near 1 keep only the square root of f32's precision, which moved the pmfs by 2e-3
-    /// when the scene's unit changed.
+    /// `p`: `p` outside every emission cone, or every point of the box in `p`'s tangent
+    /// plane.
+    ///
+    /// pbrt-v4's form, power x emission cosine x receiver cosine / squared distance, with two
+    /// changes. The distance clamp is unit-free (see the module comment). The cosines are
+    /// bounded over the box itself rather than over its bounding sphere's cone: for each,
+    /// the largest dot product of a box point with the axis (a box's corner) over the
+    /// nearest distance to the box. Seen at a grazing angle, a wide flat node of lights then
+    /// has the small cosines its lights have, where the sphere's cone gave it cosines of 1:
+    /// on a grid of lights over a floor the tree's pmf followed the 1/d^2 of the nodes'
+    /// centres instead of each light's falloff, and did little better than power choice.
+    /// In f64: sines recovered from cosines near 1 keep only the square root of f32's
+    /// precision.
     #[inline]
     pub fn importance(&self, p: Vec3, n: Vec3) -> f64 {
         let (lo, hi) = (self.lo.as_dvec3(), self.hi.as_dvec3());
+        let pd = p.as_dvec3();
         let pc = (lo + hi) * 0.5;
-        let d = p.as_dvec3() - pc;
-        let d2 = d.length_squared();
-        // The box's bounding sphere: its squared radius clamps the distance (a point inside
-        // would make the importance unbounded) and it gives the angle the box subtends.
+        let d2 = (pd - pc).length_squared();
+        // The squared radius of the box's bounding sphere clamps the distance: a point
+        // inside would make the importance unbounded.
         let r2 = 0.25 * (hi - lo).length_squared();
+        let d_min = (pd - pd.clamp(lo, hi)).length();
+        // Upper bound of cos(w, p - x) over the box points x: the largest w . (p - x) (at a
+        // corner) over the nearest distance, or if it is negative over the farthest.
         let w = self.normals.w.as_dvec3();
-        let (cos_b, wi) = if d2 <= r2 || !(d2 > 0.0) {
-            (-1.0, w)
+        let cos_w = if d_min > 0.0 {
+            let top = w.dot(pd) - (w * lo).min(w * hi).element_sum();
+            if top >= 0.0 {
+                (top / d_min).min(1.0)
+            } else {
+                let far = DVec3::select(pd.cmplt(pc), hi, lo);
+                (top / (pd - far).length()).max(-1.0)
+            }
         } else {
-            (safe_sqrt(1.0 - r2 / d2), d / d2.sqrt())
+            1.0
         };
-        let sin_b = safe_sqrt(1.0 - cos_b * cos_b);
-        let cos_w = w.dot(wi);
         let sin_w = safe_sqrt(1.0 - cos_w * cos_w);
         let (cos_o, sin_o) = (self.normals.cos as f64, self.normals.sin as f64);
-        // The angle from the cone to p, less the box's angle.
+        // The smallest angle from a normal in the cone to p.
         let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, cos_o);
-        let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, cos_o);
-        let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
-        if cos_p <= self.cos_e as f64 {
+        if cos_x <= self.cos_e as f64 {
             return 0.0;
         }
-        let mut importance = self.phi as f64 * cos_p / d2.max(r2).max(f64::MIN_POSITIVE);
-        if n != Vec3::ZERO {
-            let cos_i = wi.dot(n.as_dvec3()).abs();
-            let sin_i = safe_sqrt(1.0 - cos_i * cos_i);
-            importance *= cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
+        let mut importance = self.phi as f64 * cos_x / d2.max(r2).max(f64::MIN_POSITIVE);
+        if n != Vec3::ZERO && d_min > 0.0 {
+            // Upper bound of |cos(n, x - p)| over the box.
+            let nd = n.as_dvec3();
+            let (x, y) = (nd * lo, nd * hi);
+            let (top, bottom) = (x.max(y).element_sum(), x.min(y).element_sum());
+            let np = nd.dot(pd);
+            let reach = (top - np).abs().max((bottom - np).abs());
+            importance *= (reach / d_min).min(1.0);
         }
         importance.max(0.0)
     }

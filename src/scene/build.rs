@@ -166,7 +166,7 @@ fn area_light(
         )));
     }
     if e.radiance == Rgb::ZERO {
-        warnings.push(format!("{o}: emitter has zero radiance"));
+        warnings.push(format!("{o}: emitter has zero radiance: {NEVER_CHOSEN}"));
     }
     Ok(Emitter::Area(AreaLight {
         shape,
@@ -175,6 +175,10 @@ fn area_light(
         triangles,
     }))
 }
+
+/// What the warnings about emitters that emit nothing add: which emitter choices skip them.
+const NEVER_CHOSEN: &str = "power, exhaustive, bvh and ris choice never pick it (pmf 0); \
+                            uniform choice spends its share of light samples on it";
 
 /// Where a shadow ray from an origin to a target (at t = 1) stops: just short of the target.
 const SHADOW_TMAX: f32 = 1.0 - 1e-4;
@@ -212,6 +216,12 @@ impl Scene {
                 ));
             }
             check_rgb(&pl.origin, "point light intensity", pl.intensity)?;
+            if pl.intensity == Rgb::ZERO {
+                warnings.push(format!(
+                    "{}: point light has zero intensity: {NEVER_CHOSEN}",
+                    pl.origin
+                ));
+            }
             emitters.push(Emitter::Point(PointLight {
                 position: pl.position,
                 intensity: pl.intensity,

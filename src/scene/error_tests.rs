@@ -143,3 +143,30 @@ fn no_sensor_and_malformed_xml() {
     let e = load("<scene version=\"1.0\"/>").unwrap_err().to_string();
     assert!(e.contains("unsupported scene version"), "{e}");
 }
+
+/// Emitters that emit nothing (an area light of zero radiance, a point light of zero
+/// intensity) are warnings that name the element and say which emitter choices never pick
+/// them; the scene still renders.
+#[test]
+fn emitters_that_emit_nothing_are_named() {
+    let xml = format!(
+        "<scene version=\"3.0.0\">{SENSOR}\n{}\n<shape type=\"rectangle\"><emitter type=\"area\"><rgb name=\"radiance\" value=\"0\"/></emitter></shape>\n{LIGHT}\n</scene>",
+        r#"<emitter type="point"><point name="position" value="0,1,0"/><rgb name="intensity" value="0"/></emitter>"#
+    );
+    let scene = crate::scene::Scene::build(load(&xml).unwrap()).unwrap();
+    for (line, what) in [
+        (2, "point light has zero intensity"),
+        (3, "emitter has zero radiance"),
+    ] {
+        assert!(
+            scene
+                .warnings
+                .iter()
+                .any(|w| w.contains(&format!("test.xml:{line}"))
+                    && w.contains(what)
+                    && w.contains("never pick it")),
+            "{what}: {:?}",
+            scene.warnings
+        );
+    }
+}
