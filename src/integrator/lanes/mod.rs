@@ -14,10 +14,12 @@
 //! the BSDF's own eval, pdf and sample lane by lane: a new BSDF runs in lanes as registered.
 //!
 //! What runs in lanes (the rule `tables::lane_setup` and `camera_hits` apply):
-//! - strategy: MIS with one light and one BSDF sample (balance or power heuristic, any
-//!   emitter choice), area sampling, every emitter an area light on a mesh or a sphere.
-//!   Other strategies (light or BSDF only, N+M samples, one-sample MIS, solid-angle
-//!   sampling) and scenes with point lights render every sample with `li`;
+//! - strategy: MIS with one light and one BSDF sample (balance or power heuristic; uniform,
+//!   power, exhaustive, bvh or ris:1 emitter choice, the point-dependent ones at each lane's
+//!   hit), area sampling, every emitter an area light on a mesh or a sphere. Other
+//!   strategies (light or BSDF only, N+M samples, one-sample MIS, solid-angle sampling, RIS
+//!   over several candidates, which draws 4M + 1 numbers) and scenes with point lights
+//!   render every sample with `li`;
 //! - per batch of eight hits: every registered BSDF that is not all-delta (diffuse, rough
 //!   conductor, Nori's microfacet, plastic, rough plastic; one- or two-sided). The batch
 //!   takes the BSDF type and sidedness of its first such hit; hits of another type or
