@@ -198,7 +198,7 @@ fn lane_samples_are_bitwise_the_per_sample_definition() {
 }
 
 /// The strategies the lanes cover: multi-sample MIS with one sample per technique and area
-/// sampling, with either heuristic, every emitter choice but RIS over several candidates,
+/// sampling, with either heuristic, every emitter choice (RIS over one and four candidates),
 /// emitters shown or hidden.
 fn lane_strategies() -> Vec<Strategy> {
     let mut v = Vec::new();
@@ -209,6 +209,7 @@ fn lane_strategies() -> Vec<Strategy> {
             EmitterSelection::Exhaustive,
             EmitterSelection::Bvh,
             EmitterSelection::Ris(1),
+            EmitterSelection::Ris(4),
         ] {
             for hide_emitters in [false, true] {
                 v.push(Strategy {
@@ -324,6 +325,7 @@ fn random_scenes_render_bitwise_as_their_per_sample_definition() {
         "selection Exhaustive".into(),
         "selection Bvh".into(),
         "selection Ris(1)".into(),
+        "selection Ris(4)".into(),
         "hide_emitters true".into(),
         "hide_emitters false".into(),
         "smooth receiver".into(),

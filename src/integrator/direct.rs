@@ -14,7 +14,7 @@ use crate::bsdf::{BsdfSample, Material};
 use crate::emitter::{EmitterSelector, LightSample};
 use crate::geometry::{Hit, Ray, SurfacePoint};
 use crate::math::{luminance, Frame, Rgb};
-use crate::sampler::Sampler;
+use crate::sampler::{LightDims, Sampler};
 use crate::scene::desc::{Heuristic, StrategyKind};
 use crate::scene::Scene;
 use glam::Vec3;
@@ -25,7 +25,7 @@ pub struct Direct<'a> {
     pub(super) selector: EmitterSelector,
     has_delta_lights: bool,
     /// RIS's candidate count, if it is above 1 (`ris:1` is its source strategy, power).
-    ris: Option<u32>,
+    pub(super) ris: Option<u32>,
 }
 
 /// A light sample drawn: the point, its emitter's choice pmf and the density the estimate
@@ -84,20 +84,13 @@ impl<'a> Direct<'a> {
     /// `li` given the camera ray's hit.
     pub(super) fn li_hit(&self, ray: &Ray, sp: &SurfacePoint, rng: &mut impl Sampler) -> Rgb {
         let scene = self.scene;
-        let sp = *sp;
         let mut l = Rgb::ZERO;
         if !self.strategy.hide_emitters {
-            if let Some((_, e)) = scene.emitter_at(&sp) {
-                l += e.le(&sp, -ray.d);
+            if let Some((_, e)) = scene.emitter_at(sp) {
+                l += e.le(sp, -ray.d);
             }
         }
-        let frame = Frame::from_normal(sp.ns);
-        let sh = Shading {
-            sp,
-            frame,
-            wi: frame.to_local(-ray.d),
-            mat: scene.material(&sp),
-        };
+        let sh = self.shading(sp, ray.d);
         let s = &self.strategy;
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
         // A delta BSDF gives light samples zero throughput: all its light arrives via BSDF
@@ -176,6 +169,18 @@ impl<'a> Direct<'a> {
         l
     }
 
+    /// The shading context of a camera ray of direction `d` that hit `sp`.
+    #[inline(always)]
+    fn shading(&self, sp: &SurfacePoint, d: Vec3) -> Shading<'_> {
+        let frame = Frame::from_normal(sp.ns);
+        Shading {
+            sp: *sp,
+            frame,
+            wi: frame.to_local(-d),
+            mat: self.scene.material(sp),
+        }
+    }
+
     /// One light-technique sample. `weight(p_light, p_bsdf)` is its MIS weight divided by the
     /// technique's selection probability; a delta light is asked with p_bsdf = 0, since no
     /// other technique can produce it.
@@ -194,9 +199,9 @@ impl<'a> Direct<'a> {
     #[inline(always)]
     fn light_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<LightDraw> {
         if let Some(m) = self.ris {
-            return self.ris_draw(sh, rng, m);
+            return self.ris_draw(sh, rng, m).map(|(d, _)| d);
         }
-        let (ls, pmf) = self.candidate(sh, rng)?;
+        let (ls, pmf) = self.candidate(sh, rng.light())?;
         Some(LightDraw {
             ls,
             pmf,
@@ -204,11 +209,10 @@ impl<'a> Direct<'a> {
         })
     }
 
-    /// An emitter chosen at the shading point and a point drawn on it.
+    /// An emitter chosen at the shading point and a point drawn on it, with numbers `u`.
     #[inline(always)]
-    fn candidate(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<(LightSample, f32)> {
+    fn candidate(&self, sh: &Shading, u: LightDims) -> Option<(LightSample, f32)> {
         let scene = self.scene;
-        let u = rng.light();
         let (ei, pmf) = self.selector.sample(sh.sp.p, sh.sp.ns, u.select)?;
         let ls = scene.emitters[ei].sample(
             &scene.shapes,
@@ -225,15 +229,22 @@ impl<'a> Direct<'a> {
     /// w = p_hat / (pmf * pdf), where p_hat is the luminance of its unshadowed contribution;
     /// the estimate divides by m p_hat / sum(w). One number chooses (drawn first, with the
     /// technique's dimension), rescaled after each candidate as a reservoir of one; each
-    /// candidate takes a light sample's numbers whether it is kept or not.
+    /// candidate takes a light sample's numbers whether it is kept or not. Also returns the
+    /// kept candidate's numbers, from which the lane kernel draws it again.
     #[inline(never)]
-    fn ris_draw(&self, sh: &Shading, rng: &mut impl Sampler, m: u32) -> Option<LightDraw> {
+    fn ris_draw(
+        &self,
+        sh: &Shading,
+        rng: &mut impl Sampler,
+        m: u32,
+    ) -> Option<(LightDraw, LightDims)> {
         const BELOW_ONE: f64 = 1.0 - f64::EPSILON / 2.0;
         let mut u = rng.technique() as f64;
         let mut w_sum = 0.0f64;
-        let mut kept: Option<(LightSample, f32, f32)> = None;
+        let mut kept: Option<(LightSample, f32, f32, LightDims)> = None;
         for _ in 0..m {
-            let Some((ls, pmf)) = self.candidate(sh, rng) else {
+            let dims = rng.light();
+            let Some((ls, pmf)) = self.candidate(sh, dims) else {
                 continue;
             };
             let (f, _) = sh.mat.eval_pdf(sh.wi, sh.frame.to_local(ls.wi));
@@ -246,17 +257,34 @@ impl<'a> Direct<'a> {
             let q = w / w_sum;
             if u < q {
                 u = (u / q).min(BELOW_ONE);
-                kept = Some((ls, pmf, p_hat));
+                kept = Some((ls, pmf, p_hat, dims));
             } else {
                 u = ((u - q) / (1.0 - q)).min(BELOW_ONE);
             }
         }
-        let (ls, pmf, p_hat) = kept?;
-        Some(LightDraw {
+        let (ls, pmf, p_hat, dims) = kept?;
+        let drawn = LightDraw {
             ls,
             pmf,
             p_div: (m as f64 * p_hat as f64 / w_sum) as f32,
-        })
+        };
+        Some((drawn, dims))
+    }
+
+    /// For the lane kernel, RIS's draw at a camera ray's hit `sp` (direction `d`), with `rng`
+    /// where `li` would receive it: the kept candidate's numbers and the density the estimate
+    /// divides by, or None if no candidate was kept. `rng` is left where `li` draws its BSDF
+    /// sample. Only for `ris:M` with M > 1.
+    pub(super) fn ris_for_lane(
+        &self,
+        sp: &SurfacePoint,
+        d: Vec3,
+        rng: &mut impl Sampler,
+    ) -> Option<(LightDims, f32)> {
+        let m = self.ris.expect("RIS over several candidates");
+        let sh = self.shading(sp, d);
+        self.ris_draw(&sh, rng, m)
+            .map(|(drawn, dims)| (dims, drawn.p_div))
     }
 
     /// The rest of a light sample: BSDF, visibility and weight.

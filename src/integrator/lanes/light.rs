@@ -38,6 +38,9 @@ pub(super) struct LightDraws {
     area: [f32; LANES],
     pub(super) pmf: [f32; LANES],
     has_normals: [bool; LANES],
+    /// RIS's density of each lane's kept candidate (`ris_numbers`), which the light estimate
+    /// divides by instead of pmf * pdf; written and read only under RIS.
+    pub(super) p_div: [f32; LANES],
 }
 
 impl LightDraws {

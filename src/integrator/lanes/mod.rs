@@ -14,12 +14,11 @@
 //! the BSDF's own eval, pdf and sample lane by lane: a new BSDF runs in lanes as registered.
 //!
 //! What runs in lanes (the rule `tables::lane_setup` and `camera_hits` apply):
-//! - strategy: MIS with one light and one BSDF sample (balance or power heuristic; uniform,
-//!   power, exhaustive, bvh or ris:1 emitter choice, the point-dependent ones at each lane's
-//!   hit), area sampling, every emitter an area light on a mesh or a sphere. Other
-//!   strategies (light or BSDF only, N+M samples, one-sample MIS, solid-angle sampling, RIS
-//!   over several candidates, which draws 4M + 1 numbers) and scenes with point lights
-//!   render every sample with `li`;
+//! - strategy: MIS with one light and one BSDF sample (balance or power heuristic; every
+//!   emitter choice, the point-dependent ones at each lane's hit; RIS's candidates drawn lane
+//!   by lane with `li`'s own draw, `ris_numbers`), area sampling, every emitter an area light
+//!   on a mesh or a sphere. Other strategies (light or BSDF only, N+M samples, one-sample
+//!   MIS, solid-angle sampling) and scenes with point lights render every sample with `li`;
 //! - per batch of eight hits: every registered BSDF that is not all-delta (diffuse, rough
 //!   conductor, Nori's microfacet, plastic, rough plastic; one- or two-sided). The batch
 //!   takes the BSDF type and sidedness of its first such hit; hits of another type or
@@ -156,12 +155,15 @@ impl<'a> LaneKernel<'a> {
         let at_hit = rng.clone();
         let [u0, u1, u2, u3] = rng.light();
         let [u4, u5, u6] = rng.bsdf();
-        let u = [u0, u1, u2, u3, u4, u5, u6];
+        let mut u = [u0, u1, u2, u3, u4, u5, u6];
         let scene = direct.scene;
         scene.intersect8_into(rays, (1 << n) - 1, &mut hits.camera);
         self.camera_hits(&tables.shapes, rays, &at_hit, &mut out, hits);
         if hits.covered == 0 {
             return out;
+        }
+        if direct.ris.is_some() {
+            ris_numbers(direct, &at_hit, hits, &mut u, &mut draws.p_div);
         }
         let mut spheres = SphereDraws::default();
         let small = tables.small_lights.as_deref();
@@ -321,6 +323,36 @@ impl BsdfVisitor for Batch<'_, '_> {
             true => kernel.shade_batch_out_of_line::<B, true>(h, ld, sd, u, shaded, out),
             false => kernel.shade_batch_out_of_line::<B, false>(h, ld, sd, u, shaded, out),
         }
+    }
+}
+
+/// RIS over several candidates, whose draw `li` makes with 4M + 1 numbers: each covered
+/// lane's draw is `Direct::ris_for_lane` from the lane's own sampler. The kept candidate's
+/// numbers replace the lane's light numbers (the lane draw takes it again, bitwise as the
+/// scalar candidate), the numbers that follow are its BSDF numbers, and `p_div` is the
+/// density the lane's light estimate divides by. A lane that kept no candidate divides by
+/// infinity: its light sample, drawn from its unused numbers, adds zero, as in `li`.
+#[inline(never)]
+fn ris_numbers<L: SamplerLanes>(
+    direct: &Direct,
+    at_hit: &L,
+    h: &CameraHits,
+    u: &mut [[f32; LANES]; 7],
+    p_div: &mut [f32; LANES],
+) {
+    use crate::sampler::Sampler;
+    for i in bits(h.covered) {
+        let mut one = at_hit.lane(i);
+        match direct.ris_for_lane(&h.camera.point(i), h.d.get(i), &mut one) {
+            Some((dims, p)) => {
+                [u[0][i], u[1][i], u[2][i], u[3][i]] =
+                    [dims.select, dims.primitive, dims.point.x, dims.point.y];
+                p_div[i] = p;
+            }
+            None => p_div[i] = f32::INFINITY,
+        }
+        let b = one.bsdf();
+        [u[4][i], u[5][i], u[6][i]] = [b.lobe, b.direction.x, b.direction.y];
     }
 }
 

@@ -106,6 +106,7 @@ impl LaneKernel<'_> {
         let mut wi_up = V3x8::default();
         let mut shared = [0.0f32; LANES];
         let mut flip = [false; LANES];
+        let ris = self.direct.ris.is_some();
         for i in 0..LANES {
             let sp = h.camera.point(i);
             let (p, frame) = (sp.p, Frame::from_normal(sp.ns));
@@ -118,7 +119,9 @@ impl LaneKernel<'_> {
             let (f, pdf_bsdf) = b(i).eval_pdf_shared(wi, wo, lane_shared);
             let p_light = ld.pmf[i] * pdf_area;
             let w = heuristic(s.heuristic, ne * p_light, nb * pdf_bsdf);
-            o.light.set(i, f * radiance * (w / p_light));
+            // RIS divides by its own density; the MIS weight takes pmf * pdf (see `LightDraw`).
+            let p_div = if ris { ld.p_div[i] } else { p_light };
+            o.light.set(i, f * radiance * (w / p_div));
             o.light_ok[i] = drawn && f != Rgb::ZERO && radiance != Rgb::ZERO;
             let lp = lsp.p;
             let so = sp.spawn_origin(lp - p);

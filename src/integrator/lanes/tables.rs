@@ -275,9 +275,7 @@ pub(super) fn lane_setup<'a>(
 /// The lane lights, one per emitter, if the scene and strategy are the configuration the
 /// lanes cover.
 fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>> {
-    // RIS (above one candidate) draws a varying count of light samples: not in lanes.
     let covered = s.kind == StrategyKind::Mis
-        && s.selection.ris().is_none_or(|m| m == 1)
         && (s.emitter_samples, s.bsdf_samples) == SAMPLE_COUNTS
         && s.light_sampling == LightSampling::Area
         && !scene.emitters.is_empty();
