@@ -32,6 +32,9 @@ pub enum Command {
     /// Chi-square tests of every sampling routine against its pdf (warps, BSDFs, emitters),
     /// with heat maps; exits non-zero if any case fails.
     Chi2(crate::chi2cases::command::Chi2Args),
+    /// Run Nori test files (`<test type="ttest">`, `<test type="chi2test">`): scenes against
+    /// references per strategy, BSDF albedos, BSDF chi-square; exits non-zero on a failure.
+    Test(crate::noritest::TestArgs),
     /// The 2D test integrands of Christensen, Kensler and Kilpatrick 2018 integrated by
     /// every sampler's first 2D pair: RMSE against N, slopes against the published rates.
     Integrands(crate::integrands::report::IntegrandsArgs),
@@ -187,23 +190,17 @@ pub struct RenderArgs {
     #[arg(long)]
     pub variance: Option<PathBuf>,
     /// Set a scene parameter declared with <default>: -D name=value (repeatable).
-    #[arg(short = 'D', value_parser = parse_define)]
+    #[arg(short = 'D', value_parser = crate::scene::loader::parse_define)]
     pub define: Vec<(String, String)>,
     /// Write render statistics as JSON.
     #[arg(long)]
     pub stats: Option<PathBuf>,
+    /// `direct`: render the direct illumination of a scene whose integrator is a path tracer
+    /// or Whitted's (refused without it); the image is the direct part only.
+    #[arg(long, value_enum)]
+    pub integrator: Option<crate::scene::loader::IntegratorMode>,
     #[command(flatten)]
     pub strategy: StrategyOverrides,
-}
-
-fn parse_define(s: &str) -> Result<(String, String), String> {
-    let (k, v) = s
-        .split_once('=')
-        .ok_or_else(|| format!("expected name=value, found '{s}'"))?;
-    if k.is_empty() {
-        return Err(format!("expected name=value, found '{s}'"));
-    }
-    Ok((k.to_string(), v.to_string()))
 }
 
 #[derive(serde::Serialize)]
@@ -221,6 +218,8 @@ struct RenderStats {
     samples_per_second: f64,
     non_finite_samples: u64,
     mean_rgb: [f64; 3],
+    /// The global-illumination integrator the scene names, when the image is its direct part.
+    direct_part_of: Option<String>,
 }
 
 /// The files `render` writes, checked before the scene is even loaded: each can be written,
@@ -263,7 +262,7 @@ fn render_outputs(a: &RenderArgs) -> Result<PathBuf, String> {
 
 fn cmd_render(a: &RenderArgs) -> Result<(), String> {
     let out = render_outputs(a)?;
-    let scene = crate::scene::open(&a.scene, &a.define)?;
+    let scene = crate::scene::open_with(&a.scene, &a.define, a.integrator)?;
     let strategy = a
         .strategy
         .apply(Strategy::from_desc(&scene.desc.integrator))?;
@@ -300,6 +299,7 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
         samples_per_second: result.samples_per_second(),
         non_finite_samples: result.non_finite_samples,
         mean_rgb: result.mean.mean_rgb(),
+        direct_part_of: scene.desc.integrator.direct_part_of.clone(),
     };
     if let Some(p) = &a.stats {
         let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
@@ -341,6 +341,10 @@ pub fn main() -> i32 {
                 .ok_or_else(|| "some sampling routines do not match their pdfs".to_string())
         }),
         Command::Extreme(a) => cmd_extreme(a),
+        Command::Test(a) => crate::noritest::run(a).and_then(|ok| {
+            ok.then_some(())
+                .ok_or_else(|| "some tests failed (see the tables above)".to_string())
+        }),
     };
     match r {
         Ok(()) => 0,

@@ -17,6 +17,7 @@ pub mod integrands;
 pub mod integrator;
 pub mod math;
 pub mod metrics;
+pub mod noritest;
 pub mod output;
 pub mod plot;
 pub mod render;

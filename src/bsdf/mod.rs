@@ -104,6 +104,12 @@ pub trait Bsdf: Sized + Copy {
     // BSDF sample of a hit, or to sample in vector lanes. Each override must give bitwise
     // what the methods above give (the lane tests compare every sample with `li`'s).
 
+    /// The roughness (alpha_u, alpha_v) of a glossy reflection lobe, for the chi-square
+    /// tests, which bin narrow lobes in a window fitted to them; None by default.
+    fn glossy_lobe(&self) -> Option<(f32, f32)> {
+        None
+    }
+
     /// Whether the lane kernel shades this BSDF (every one with a density, by default); a
     /// BSDF whose lane methods cover only some of its parameters says which, and the rest
     /// shade lane by lane with `Direct::li_hit`.
@@ -211,6 +217,13 @@ macro_rules! registry {
             pub fn is_delta(&self) -> bool {
                 match self {
                     $(BsdfKind::$variant(_) => <$ty as Bsdf>::DELTA,)*
+                }
+            }
+
+            /// `Bsdf::glossy_lobe` of the BSDF it holds.
+            pub fn glossy_lobe(&self) -> Option<(f32, f32)> {
+                match self {
+                    $(BsdfKind::$variant(b) => Bsdf::glossy_lobe(b),)*
                 }
             }
 

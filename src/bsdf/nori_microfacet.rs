@@ -108,6 +108,10 @@ impl NoriMicrofacet {
 }
 
 impl Bsdf for NoriMicrofacet {
+    fn glossy_lobe(&self) -> Option<(f32, f32)> {
+        Some((self.alpha, self.alpha))
+    }
+
     const DELTA: bool = false;
 
     /// Nori's `alpha` (default 0.1), `intIOR`, `extIOR` and `kd` (default 0.5, at most 1).

@@ -156,6 +156,10 @@ impl RoughConductor {
 }
 
 impl Bsdf for RoughConductor {
+    fn glossy_lobe(&self) -> Option<(f32, f32)> {
+        Some((self.mf.alpha_u, self.mf.alpha_v))
+    }
+
     const DELTA: bool = false;
 
     /// Mitsuba's `distribution` (beckmann, ggx), `alpha` or `alpha_u` and `alpha_v` (default

@@ -143,6 +143,10 @@ impl RoughPlastic {
 }
 
 impl Bsdf for RoughPlastic {
+    fn glossy_lobe(&self) -> Option<(f32, f32)> {
+        self.coat.glossy_lobe()
+    }
+
     const DELTA: bool = false;
 
     /// Mitsuba 3's names and defaults: those of `plastic` and the microfacet lobe's

@@ -190,9 +190,21 @@ pub fn run(a: &Chi2Args) -> Result<bool, String> {
         alpha: sidak(ALPHA, cases.len()),
         ..CaseConfig::default()
     };
+    run_cases(&cases, &cfg, ALPHA, &a.out)
+}
+
+/// Runs `cases` (in parallel) with `cfg`, whose `alpha` is the per-case level that makes
+/// `family_alpha` over the run; prints the table and failures, writes `results.csv` and the
+/// heat maps under `out`. Ok(true) when every case passed.
+pub fn run_cases(
+    cases: &[super::Case],
+    cfg: &CaseConfig,
+    family_alpha: f64,
+    out: &Path,
+) -> Result<bool, String> {
     eprintln!(
-        "{} cases, {} samples each, resolution {}, seed {}; alpha {ALPHA} Sidak-corrected to \
-         {:.3e} per case",
+        "{} cases, {} samples each, resolution {}, seed {}; alpha {family_alpha} \
+         Sidak-corrected to {:.3e} per case",
         cases.len(),
         cfg.samples,
         cfg.resolution,
@@ -204,7 +216,7 @@ pub fn run(a: &Chi2Args) -> Result<bool, String> {
         .par_iter()
         .map(|case| {
             let t = Instant::now();
-            let outcome = case.run(&cfg);
+            let outcome = case.run(cfg);
             let seconds = t.elapsed().as_secs_f64();
             eprintln!(
                 "  {:<44} {} ({seconds:.1} s)",
@@ -216,10 +228,10 @@ pub fn run(a: &Chi2Args) -> Result<bool, String> {
         .collect();
     print!("{}", table(&rows));
     for t in &rows {
-        write_png(&a.out, &t.outcome)?;
+        write_png(out, &t.outcome)?;
     }
-    let csv = a.out.join("results.csv");
-    write_csv(&csv, &rows, &cfg)?;
+    let csv = out.join("results.csv");
+    write_csv(&csv, &rows, cfg)?;
     let failed: Vec<&Timed> = rows.iter().filter(|t| !t.outcome.passed()).collect();
     for t in &failed {
         println!("FAIL {}: {}", t.outcome.name, t.outcome.summary());
@@ -230,7 +242,7 @@ pub fn run(a: &Chi2Args) -> Result<bool, String> {
         rows.len(),
         start.elapsed().as_secs_f64(),
         csv.display(),
-        a.out.display()
+        out.display()
     );
     Ok(failed.is_empty())
 }

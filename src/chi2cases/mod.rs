@@ -47,6 +47,9 @@ pub struct CaseConfig {
     /// light seen at grazing angles gets too small an expected count and a correct sampler
     /// is rejected (p ~ 1e-40 on `emitter/mesh-area-grazing`).
     pub integration: Integration,
+    /// Cells expected to receive fewer samples than this are pooled (Nori's
+    /// `minExpFrequency`).
+    pub min_expected: f64,
 }
 
 impl Default for CaseConfig {
@@ -60,6 +63,7 @@ impl Default for CaseConfig {
                 boundary_split: 8,
                 ..Integration::default()
             },
+            min_expected: 5.0,
         }
     }
 }
@@ -72,6 +76,7 @@ impl CaseConfig {
             threshold,
             seed: self.seed,
             integration: self.integration,
+            min_expected: self.min_expected,
             ..Chi2Config::default()
         }
     }

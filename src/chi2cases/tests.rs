@@ -250,3 +250,12 @@ fn every_registered_bsdf_with_a_density_has_chi2_cases() {
         );
     }
 }
+
+/// `Bsdf::glossy_lobe`, which `directlab test` uses to window a user's BSDF, names the same
+/// lobe as the registry's entries for every material there.
+#[test]
+fn glossy_lobe_is_the_registry_lobe() {
+    for e in super::bsdfs::materials() {
+        assert_eq!(e.material.kind.glossy_lobe(), e.lobe, "{}", e.name);
+    }
+}

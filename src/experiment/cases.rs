@@ -160,6 +160,8 @@ pub struct Case {
     pub name: String,
     pub scene: PathBuf,
     pub defines: Vec<(String, String)>,
+    /// How the scene's integrator is read (the experiment's `integrator`).
+    pub integrator: Option<crate::scene::loader::IntegratorMode>,
     pub value: Option<f64>,
     pub closed_form: Option<ClosedForm>,
     pub group: String,

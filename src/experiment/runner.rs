@@ -43,6 +43,9 @@ pub struct Outcome {
     pub seconds: f64,
     pub width: u32,
     pub height: u32,
+    /// The global-illumination integrator the scene names, when the images are its direct
+    /// part (`integrator = "direct"`).
+    pub direct_part_of: Option<String>,
 }
 
 struct Ctx<'a> {
@@ -214,7 +217,7 @@ fn equal_time_jobs(
 pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, String> {
     let start = Instant::now();
     let dir = opts.out.join(&exp.name);
-    let scene = crate::scene::open(exp.scene(), exp.defines())?;
+    let scene = crate::scene::open_with(exp.scene(), exp.defines(), exp.cases[0].integrator)?;
     let base = Strategy::from_desc(&scene.desc.integrator);
     let (kept, omitted) = strategies(&exp, base, &scene)?;
 
@@ -328,6 +331,7 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
         seconds: start.elapsed().as_secs_f64(),
         width: scene.camera.width,
         height: scene.camera.height,
+        direct_part_of: scene.desc.integrator.direct_part_of.clone(),
         dir,
         exp,
         reference,

@@ -30,6 +30,10 @@ pub struct Experiment {
     /// `-D name=value` overrides of the scene's `<default>`s (of every case's scene).
     #[serde(default)]
     pub defines: BTreeMap<String, String>,
+    /// `"direct"`: read a scene whose integrator is a path tracer or Whitted's as its direct
+    /// illumination (the CLI's `--integrator direct`); the report says the images are the
+    /// direct part only.
+    pub integrator: Option<crate::scene::loader::IntegratorMode>,
     /// Samples per pixel of the sweep (in probe mode: the batch sizes).
     pub spp: Vec<u32>,
     /// Independent repetitions of every (strategy, spp); seeds are 0..seeds.

@@ -45,6 +45,7 @@ pub(crate) fn cases(exp: &Experiment, file: &Path) -> Result<Vec<Case>, String> 
             name: c.name.clone(),
             scene: dir.join(&c.scene),
             defines: merge_defines(&[&exp.defines, &c.defines]),
+            integrator: exp.integrator,
             value: c.reference.value.or(exp.reference.value),
             closed_form: c.reference.closed_form.or(exp.reference.closed_form),
             group: c.group.clone(),

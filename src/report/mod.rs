@@ -119,6 +119,16 @@ fn left_out(md: &mut String, o: &Outcome) {
     md.push('\n');
 }
 
+/// What a report says when its scene's integrator was read as its direct part.
+pub fn direct_part_note(integrator: &str) -> String {
+    format!(
+        "**Direct illumination only.** The scene names the global-illumination integrator \
+         `{integrator}`; with `integrator = \"direct\"` directlab renders its direct part (one \
+         bounce from the camera's hit), so these images are not what `{integrator}` renders \
+         where light bounces more than once."
+    )
+}
+
 /// Writes `<dir>/index.md`.
 pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> Result<(), String> {
     let mut md = String::new();
@@ -131,6 +141,9 @@ pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> R
     let _ = writeln!(md, "# {title}\n");
     if !o.exp.exp.description.is_empty() {
         let _ = writeln!(md, "{}\n", o.exp.exp.description.trim());
+    }
+    if let Some(t) = &o.direct_part_of {
+        let _ = writeln!(md, "{}\n", direct_part_note(t));
     }
     settings(&mut md, o);
     left_out(&mut md, o);

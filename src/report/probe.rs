@@ -251,6 +251,13 @@ pub fn write(o: &ProbeOutcome, figure: Option<&str>) -> Result<(), String> {
     if !x.description.is_empty() {
         let _ = writeln!(md, "{}\n", x.description.trim());
     }
+    if x.integrator.is_some() {
+        let _ = writeln!(
+            md,
+            "**Direct illumination only.** `integrator = \"direct\"`: scenes whose integrator \
+             is a path tracer or Whitted's are rendered as their direct part.\n"
+        );
+    }
     settings(&mut md, o, t.len());
     if let Some(f) = figure {
         let _ = writeln!(

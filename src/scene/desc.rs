@@ -130,6 +130,10 @@ pub struct IntegratorDesc {
     pub emitter_samples: u32,
     pub bsdf_samples: u32,
     pub hide_emitters: bool,
+    /// The global-illumination integrator (`path_mis`, `path`, ...) this scene names, when it
+    /// was read as its direct illumination (`--integrator direct`): the image is the direct
+    /// part only.
+    pub direct_part_of: Option<String>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

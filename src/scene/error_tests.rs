@@ -99,7 +99,9 @@ fn unknown_plugin_and_parameter() {
     let e = m3_err(r#"<shape type="rectangle" colour="red"/>"#);
     assert!(e.contains("unexpected attribute 'colour'"), "{e}");
     let e = m3_err(r#"<integrator type="path"/>"#);
-    assert!(e.starts_with("dir/test.xml:2: <integrator type=\"path\">: only direct illumination is supported; found integrator 'path'"), "{e}");
+    assert!(e.starts_with("dir/test.xml:2: <integrator type=\"path\">: integrator 'path' renders global illumination"), "{e}");
+    let e = m3_err(r#"<integrator type="bdpt"/>"#);
+    assert!(e.starts_with("dir/test.xml:2: <integrator type=\"bdpt\">: only direct illumination is supported; found integrator 'bdpt'"), "{e}");
 }
 
 #[test]

@@ -33,6 +33,7 @@ fn base(camera: Mat4, fov: f32, width: u32, height: u32, shapes: Vec<ShapeDesc>)
             emitter_samples: 1,
             bsdf_samples: 1,
             hide_emitters: false,
+            direct_part_of: None,
         },
         shapes,
         point_lights: vec![],

@@ -25,10 +25,55 @@ pub enum Dialect {
     Nori,
 }
 
+/// How a scene's `<integrator>` is read (`--integrator`, `integrator = ...` in experiment
+/// files).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum IntegratorMode {
+    /// Render the direct illumination of a scene whose integrator is a path tracer or
+    /// Whitted's (Nori's path_mis, path_ems, path_mats, whitted; Mitsuba's path, volpath):
+    /// the image is then the direct part only
+    Direct,
+}
+
+/// Global-illumination integrators whose direct illumination directlab renders under
+/// `--integrator direct`, and the strategy their direct part uses: Nori's path_ems and
+/// whitted sample emitters, path_mats the BSDF, path_mis both with the balance heuristic;
+/// Mitsuba's path tracers both with the power heuristic.
+pub const DIRECT_PART_OF: &[(&str, StrategyKind)] = &[
+    ("path_mis", StrategyKind::Mis),
+    ("path_ems", StrategyKind::Light),
+    ("path_mats", StrategyKind::Bsdf),
+    ("whitted", StrategyKind::Light),
+    ("path", StrategyKind::Mis),
+    ("volpath", StrategyKind::Mis),
+];
+
+/// A `-D name=value` define from the command line.
+pub fn parse_define(s: &str) -> Result<(String, String), String> {
+    let (k, v) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected name=value, found '{s}'"))?;
+    if k.is_empty() {
+        return Err(format!("expected name=value, found '{s}'"));
+    }
+    Ok((k.to_string(), v.to_string()))
+}
+
 /// Reads a scene file. `defines` are the CLI's `-D name=value` overrides.
 pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<SceneDesc, SceneError> {
+    load_scene_with(path, defines, None)
+}
+
+/// [`load_scene`] with the integrator read as `mode` says.
+pub fn load_scene_with(
+    path: &Path,
+    defines: &[(String, String)],
+    mode: Option<IntegratorMode>,
+) -> Result<SceneDesc, SceneError> {
     let xml = read_text_file(path, MAX_SCENE_BYTES, "scene file")?;
-    load_scene_str(&xml, path, defines)
+    let root = parse_document(&xml, path, defines)?;
+    load_scene_element(&root, path, mode)
 }
 
 /// The largest scene file read (meshes live in their own files): far above any hand-written
@@ -85,6 +130,19 @@ pub fn load_scene_str(
     if root.tag != "scene" {
         return Err(root.err("expected <scene> as the root element"));
     }
+    load_scene_element(&root, path, None)
+}
+
+/// A scene from its `<scene>` element (the root of a scene file, or a scene inside a Nori
+/// test file); `path` is the file it came from.
+pub fn load_scene_element(
+    root: &Element,
+    path: &Path,
+    mode: Option<IntegratorMode>,
+) -> Result<SceneDesc, SceneError> {
+    if root.tag != "scene" {
+        return Err(root.err("expected <scene> as the root element"));
+    }
     root.check_attrs(&["version"])?;
     let dialect = match root.attr("version") {
         None => Dialect::Nori,
@@ -104,10 +162,31 @@ pub fn load_scene_str(
         bsdf_elems: HashMap::new(),
         bsdfs: HashMap::new(),
         resolving: HashSet::new(),
+        mode,
     };
-    let mut desc = loader.scene(&root, path)?;
+    let mut desc = loader.scene(root, path)?;
     desc.warnings = loader.warnings;
     Ok(desc)
+}
+
+/// A BSDF from its `<bsdf>` element in `dialect` (a BSDF inside a Nori test file); its
+/// warnings are returned beside it.
+pub fn load_bsdf_element(
+    e: &Element,
+    path: &Path,
+    dialect: Dialect,
+) -> Result<(Material, Vec<String>), SceneError> {
+    let mut loader = Loader {
+        dialect,
+        base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        warnings: Vec::new(),
+        bsdf_elems: HashMap::new(),
+        bsdfs: HashMap::new(),
+        resolving: HashSet::new(),
+        mode: None,
+    };
+    let m = loader.bsdf(e)?;
+    Ok((m, loader.warnings))
 }
 
 pub(super) struct Loader<'a> {
@@ -118,6 +197,7 @@ pub(super) struct Loader<'a> {
     pub(super) bsdf_elems: HashMap<String, &'a Element>,
     pub(super) bsdfs: HashMap<String, Material>,
     pub(super) resolving: HashSet<String>,
+    pub(super) mode: Option<IntegratorMode>,
 }
 
 /// Plugin types that exist in Mitsuba or Nori but that directlab does not implement; naming
@@ -251,6 +331,7 @@ impl<'a> Loader<'a> {
                 emitter_samples: 1,
                 bsdf_samples: 1,
                 hide_emitters: false,
+                direct_part_of: None,
             }),
             shapes,
             point_lights,

@@ -158,7 +158,71 @@ fn nori_defaults_and_sampling_values() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("only direct illumination is supported; found integrator 'path_mis'"),
+        e.contains("integrator 'path_mis' renders global illumination")
+            && e.contains("pass --integrator direct")
+            && e.contains("integrator = \"direct\"")
+            && e.starts_with("dir/test.xml:1"),
         "{e}"
     );
+}
+
+/// `--integrator direct`: every path tracer (and Whitted's) is read as its direct part with
+/// the strategy its name implies, says so, and drops the path depth with a warning; other
+/// integrators stay refused, and without the mode the path tracers are refused.
+#[test]
+fn global_illumination_integrators_read_as_their_direct_part() {
+    use crate::scene::loader::{load_scene_element, IntegratorMode};
+    use crate::scene::xml::parse_document;
+    let scene = |integrator: &str, version: &str| {
+        format!(
+            r#"<scene{version}>{integrator}<sensor type="perspective"/>
+            <emitter type="point"><point name="position" value="0,1,0"/><rgb name="intensity" value="1"/></emitter></scene>"#
+        )
+    };
+    let direct = |xml: &str| {
+        let root = parse_document(xml, Path::new("t.xml"), &[]).unwrap();
+        load_scene_element(&root, Path::new("t.xml"), Some(IntegratorMode::Direct))
+    };
+    let cases = [
+        ("path_mis", "", StrategyKind::Mis, Heuristic::Balance),
+        ("path_ems", "", StrategyKind::Light, Heuristic::Balance),
+        ("path_mats", "", StrategyKind::Bsdf, Heuristic::Balance),
+        ("whitted", "", StrategyKind::Light, Heuristic::Balance),
+        (
+            "path",
+            " version=\"3.0.0\"",
+            StrategyKind::Mis,
+            Heuristic::Power,
+        ),
+        (
+            "volpath",
+            " version=\"3.0.0\"",
+            StrategyKind::Mis,
+            Heuristic::Power,
+        ),
+    ];
+    for (ty, version, kind, heuristic) in cases {
+        let xml = scene(
+            &format!(
+                r#"<integrator type="{ty}"><integer name="max_depth" value="5"/></integrator>"#
+            ),
+            version,
+        );
+        let s = direct(&xml).unwrap_or_else(|e| panic!("{ty}: {e}"));
+        let i = &s.integrator;
+        assert_eq!((i.strategy, i.heuristic), (kind, heuristic), "{ty}");
+        assert_eq!(i.direct_part_of.as_deref(), Some(ty));
+        assert!(
+            s.warnings.iter().any(|w| w.contains("max_depth")),
+            "{ty}: {:?}",
+            s.warnings
+        );
+        assert!(load(&xml).is_err(), "{ty} refused without the mode");
+    }
+    let plain = direct(&scene(r#"<integrator type="direct"/>"#, "")).unwrap();
+    assert_eq!(plain.integrator.direct_part_of, None);
+    let e = direct(&scene(r#"<integrator type="bdpt"/>"#, " version=\"3.0.0\""))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("found integrator 'bdpt'"), "{e}");
 }

@@ -98,7 +98,8 @@ fn mitsuba3_defaults() {
             heuristic: Heuristic::Power,
             emitter_samples: 1,
             bsdf_samples: 1,
-            hide_emitters: false
+            hide_emitters: false,
+            direct_part_of: None,
         }
     );
     assert_eq!(s.camera.fov_axis, FovAxis::X);
@@ -142,7 +143,8 @@ fn mitsuba3_sensor_film_sampler_integrator() {
             heuristic: Heuristic::Power,
             emitter_samples: 2,
             bsdf_samples: 3,
-            hide_emitters: true
+            hide_emitters: true,
+            direct_part_of: None,
         }
     );
     assert_eq!(s.camera.fov_degrees, 39.3);

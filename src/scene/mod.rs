@@ -55,7 +55,24 @@ pub(crate) mod random;
 /// Loads and builds a scene, printing its warnings to stderr. A film too large for this
 /// machine's memory is refused here, before any render starts.
 pub fn open(path: &std::path::Path, defines: &[(String, String)]) -> Result<Scene, String> {
-    let desc = load_scene(path, defines).map_err(|e| e.to_string())?;
+    open_with(path, defines, None)
+}
+
+/// [`open`] with the integrator read as `mode` says; says so when a global-illumination
+/// integrator was read as its direct part.
+pub fn open_with(
+    path: &std::path::Path,
+    defines: &[(String, String)],
+    mode: Option<loader::IntegratorMode>,
+) -> Result<Scene, String> {
+    let desc = loader::load_scene_with(path, defines, mode).map_err(|e| e.to_string())?;
+    if let Some(t) = &desc.integrator.direct_part_of {
+        eprintln!(
+            "note: {}: integrator '{t}' read as its direct illumination (--integrator direct): \
+             the image is the direct part only",
+            path.display()
+        );
+    }
     let scene = Scene::build(desc).map_err(|e| e.to_string())?;
     crate::film::check_film_memory(scene.camera.width, scene.camera.height)
         .map_err(|e| format!("{}: {e}", path.display()))?;

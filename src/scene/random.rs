@@ -502,6 +502,7 @@ pub fn random_scene(seed: u64, dir: &Path) -> RandomScene {
             emitter_samples: 1,
             bsdf_samples: 1,
             hide_emitters: false,
+            direct_part_of: None,
         },
         shapes,
         point_lights,

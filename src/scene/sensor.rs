@@ -2,7 +2,9 @@
 
 use super::desc::*;
 use super::error::SceneError;
-use super::loader::{similarity_scale, unknown, unsupported, Loader};
+use super::loader::{
+    similarity_scale, unknown, unsupported, IntegratorMode, Loader, DIRECT_PART_OF,
+};
 use super::props::Plugin;
 use super::xml::{parse_float, Element};
 use glam::Mat4;
@@ -54,11 +56,28 @@ impl<'a> Loader<'a> {
         } else {
             Heuristic::Power
         };
+        let mut direct_part_of = None;
         let (mut strategy, mut heuristic) = match ty {
             "direct" => (StrategyKind::Mis, default_heuristic),
             "direct_ems" => (StrategyKind::Light, default_heuristic),
             "direct_mats" => (StrategyKind::Bsdf, default_heuristic),
             "direct_mis" => (StrategyKind::Mis, Heuristic::Balance),
+            t if DIRECT_PART_OF.iter().any(|(n, _)| *n == t) => {
+                if self.mode != Some(IntegratorMode::Direct) {
+                    return Err(e.err(format!(
+                        "integrator '{t}' renders global illumination, and directlab renders \
+                         direct illumination only; to render this scene's direct illumination, \
+                         pass --integrator direct (in an experiment file: integrator = \"direct\")"
+                    )));
+                }
+                direct_part_of = Some(t.to_string());
+                let kind = DIRECT_PART_OF.iter().find(|(n, _)| *n == t).map(|x| x.1);
+                let h = match t.starts_with("path_") || t == "whitted" {
+                    true => Heuristic::Balance,
+                    false => Heuristic::Power,
+                };
+                (kind.expect("listed"), h)
+            }
             t if KNOWN_INTEGRATORS.contains(&t) => {
                 return Err(e.err(format!(
                     "only direct illumination is supported; found integrator '{t}'"
@@ -99,6 +118,11 @@ impl<'a> Loader<'a> {
         let emitter_samples = p.count("emitter_samples")?.or(shading).unwrap_or(1);
         let bsdf_samples = p.count("bsdf_samples")?.or(shading).unwrap_or(1);
         let hide_emitters = p.boolean("hide_emitters")?.unwrap_or(false);
+        if direct_part_of.is_some() {
+            for key in ["max_depth", "rr_depth"] {
+                p.ignore(key, "the direct part has one bounce", &mut self.warnings);
+            }
+        }
         p.ignore(
             "strict_normals",
             "directlab always uses the geometric normal for visibility",
@@ -114,6 +138,7 @@ impl<'a> Loader<'a> {
             emitter_samples,
             bsdf_samples,
             hide_emitters,
+            direct_part_of,
         })
     }
 

@@ -15,7 +15,7 @@ use crate::experiment::results::{Results, Row};
 use crate::experiment::schema::Experiment;
 use crate::experiment::{Resolved, RunOptions};
 use crate::integrator::{Direct, Strategy};
-use crate::scene::{load_scene, Scene};
+use crate::scene::Scene;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -84,7 +84,8 @@ pub fn measure_stream(
 
 fn open_case(exp: &Resolved, c: &Case) -> Result<(Scene, Option<Check>, Option<f64>), String> {
     let at = |e: String| format!("{}: case '{}': {e}", exp.file.display(), c.name);
-    let desc = load_scene(&c.scene, &c.defines).map_err(|e| at(e.to_string()))?;
+    let desc = crate::scene::loader::load_scene_with(&c.scene, &c.defines, c.integrator)
+        .map_err(|e| at(e.to_string()))?;
     let scene = Scene::build(desc).map_err(|e| at(e.to_string()))?;
     let warned = c.warning.as_ref().map(|w| {
         check(
@@ -369,7 +370,7 @@ fn run_accumulation(
         .expect("validated: the case exists");
     let own: BTreeMap<String, String> = c.case.defines.iter().cloned().collect();
     let defines = crate::experiment::cases::merge_defines(&[&own, &a.defines]);
-    let scene = crate::scene::open(&c.case.scene, &defines)?;
+    let scene = crate::scene::open_with(&c.case.scene, &defines, c.case.integrator)?;
     let base = Strategy::from_desc(&scene.desc.integrator);
     let mut h = Fnv::new();
     h.field(c.context.as_bytes());
