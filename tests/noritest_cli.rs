@@ -267,3 +267,40 @@ fn path_tracer_scenes_render_their_direct_part_when_asked() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("integrator = \"direct\""));
 }
+
+/// `chi2 --scene`: a scene's own BSDFs (at the registry's incident directions, grazing
+/// included) and its light sampling from receiver points, with its emitter choice; results
+/// and heat maps under `<out>/scenes/<name>/`; what cannot be tested is said with the reason.
+#[test]
+fn chi2_of_a_scene_tests_its_bsdfs_and_lights() {
+    let out = scratch("chi2-scene");
+    let o = run(directlab()
+        .arg("chi2")
+        .arg("--scene")
+        .arg(repo("scenes/veach-mis/veach-mis.xml"))
+        .args(["--samples", "50000", "--emitter-selection", "bvh", "--out"])
+        .arg(&out));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(out.join("scenes/veach-mis/results.csv")).unwrap();
+    for want in [
+        "scene/bsdf2-roughconductor-grazing",
+        "scene/lights-bvh-receiver0",
+        "scene/bsdf0-diffuse-normal",
+    ] {
+        assert!(csv.contains(want), "{want} missing from {csv}");
+    }
+    assert!(out
+        .join("scenes/veach-mis/scene/lights-bvh-receiver0.png")
+        .exists());
+    assert!(
+        stderr(&o).contains("left out: receiver 2"),
+        "{}",
+        stderr(&o)
+    );
+    let o = run(directlab()
+        .arg("chi2")
+        .arg("--scene")
+        .arg(repo("scenes/cbox/no-such.xml")));
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("no-such.xml"), "{}", stderr(&o));
+}

@@ -34,6 +34,19 @@ pub struct Chi2Args {
     /// List the cases (name and description) and exit.
     #[arg(long)]
     pub list: bool,
+    /// Test a scene's own BSDFs and light sampling instead of the built-in cases (results
+    /// under `<out>/scenes/<scene name>/`).
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// The scene's emitter choice (default: uniform, the study's).
+    #[arg(long, default_value = "uniform")]
+    pub emitter_selection: crate::emitter::EmitterSelection,
+    /// The scene's light sampling.
+    #[arg(long, value_enum, default_value = "area")]
+    pub light_sampling: crate::emitter::LightSampling,
+    /// Set a scene parameter declared with <default>: -D name=value (repeatable).
+    #[arg(short = 'D', value_parser = crate::scene::loader::parse_define)]
+    pub define: Vec<(String, String)>,
 }
 
 /// The largest `--resolution`: its tables stay within a few hundred MB per case in flight.
@@ -167,7 +180,34 @@ pub fn table(rows: &[Timed]) -> String {
 
 /// Runs the command; Ok(true) when every case passed.
 pub fn run(a: &Chi2Args) -> Result<bool, String> {
-    let cases = select(a.filter.as_deref().unwrap_or(""));
+    let (cases, out) = match &a.scene {
+        None => (select(a.filter.as_deref().unwrap_or("")), a.out.clone()),
+        Some(path) => {
+            use crate::scene::loader::IntegratorMode;
+            // The integrator does not matter to the samplers tested: a path tracer's scene
+            // is read as its direct part.
+            let scene = crate::scene::open_with(path, &a.define, Some(IntegratorMode::Direct))?;
+            let (all, left) = super::scene::cases(
+                std::sync::Arc::new(scene),
+                a.emitter_selection,
+                a.light_sampling,
+            );
+            for l in &left {
+                eprintln!("left out: {l}");
+            }
+            let filter = a.filter.as_deref().unwrap_or("");
+            let cases: Vec<_> = all
+                .into_iter()
+                .filter(|c| c.name.contains(filter))
+                .collect();
+            let stem = path
+                .file_stem()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned();
+            (cases, a.out.join("scenes").join(stem))
+        }
+    };
     if a.list {
         for c in &cases {
             println!("{:<40} {}", c.name, c.about);
@@ -190,7 +230,7 @@ pub fn run(a: &Chi2Args) -> Result<bool, String> {
         alpha: sidak(ALPHA, cases.len()),
         ..CaseConfig::default()
     };
-    run_cases(&cases, &cfg, ALPHA, &a.out)
+    run_cases(&cases, &cfg, ALPHA, &out)
 }
 
 /// Runs `cases` (in parallel) with `cfg`, whose `alpha` is the per-case level that makes
@@ -261,6 +301,10 @@ mod tests {
             seed: 3,
             out: dir.clone(),
             list: false,
+            scene: None,
+            emitter_selection: crate::emitter::EmitterSelection::Uniform,
+            light_sampling: crate::emitter::LightSampling::Area,
+            define: vec![],
         };
         // 20k samples on 11 x 11 cells at alpha 0.01: a correct warp passes.
         assert_eq!(run(&args), Ok(true));

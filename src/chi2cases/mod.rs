@@ -18,6 +18,7 @@ pub mod discrete;
 pub mod emitters;
 pub mod lobe;
 pub mod probe;
+pub mod scene;
 pub mod tangent;
 pub mod warps;
 
