@@ -7,6 +7,7 @@ pub mod analytic;
 pub mod bench;
 pub mod bsdf;
 pub mod camera;
+pub mod check;
 pub mod chi2cases;
 pub mod cli;
 pub mod emitter;
