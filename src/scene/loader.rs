@@ -155,15 +155,7 @@ pub fn load_scene_element(
             )))
         }
     };
-    let mut loader = Loader {
-        dialect,
-        base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
-        warnings: Vec::new(),
-        bsdf_elems: HashMap::new(),
-        bsdfs: HashMap::new(),
-        resolving: HashSet::new(),
-        mode,
-    };
+    let mut loader = Loader::new(dialect, path, mode);
     let mut desc = loader.scene(root, path)?;
     desc.warnings = loader.warnings;
     Ok(desc)
@@ -176,15 +168,7 @@ pub fn load_bsdf_element(
     path: &Path,
     dialect: Dialect,
 ) -> Result<(Material, Vec<String>), SceneError> {
-    let mut loader = Loader {
-        dialect,
-        base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
-        warnings: Vec::new(),
-        bsdf_elems: HashMap::new(),
-        bsdfs: HashMap::new(),
-        resolving: HashSet::new(),
-        mode: None,
-    };
+    let mut loader = Loader::new(dialect, path, None);
     let m = loader.bsdf(e)?;
     Ok((m, loader.warnings))
 }
@@ -224,6 +208,19 @@ pub(super) fn unknown(elem: &Element, kind: &str, ty: &str, supported: &str) -> 
 }
 
 impl<'a> Loader<'a> {
+    /// A loader for a document at `path` (relative mesh paths resolve against its folder).
+    fn new(dialect: Dialect, path: &Path, mode: Option<IntegratorMode>) -> Self {
+        Loader {
+            dialect,
+            base_dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+            warnings: Vec::new(),
+            bsdf_elems: HashMap::new(),
+            bsdfs: HashMap::new(),
+            resolving: HashSet::new(),
+            mode,
+        }
+    }
+
     pub(super) fn is_nori(&self) -> bool {
         self.dialect == Dialect::Nori
     }
