@@ -98,14 +98,8 @@ impl Options {
 pub fn chi2_directions(s: &impl DirectionSampler, o: &Options) -> Outcome {
     let cfg = o.config();
     let domain: Sphere = cfg.sphere();
-    run_continuous(
-        "directions",
-        &domain,
-        |r: &mut Rng| s.sample(r.next_2d()),
-        |d| s.pdf(d),
-        &cfg,
-        vec![],
-    )
+    let sample = |r: &mut Rng| s.sample(r.next_2d());
+    run_continuous("directions", &domain, sample, |d| s.pdf(d), &cfg, vec![])
 }
 
 /// Chi-square of a unit-square sampler against its pdf.
@@ -128,14 +122,8 @@ pub fn chi2_directions(s: &impl DirectionSampler, o: &Options) -> Outcome {
 pub fn chi2_square(s: &impl SquareSampler, o: &Options) -> Outcome {
     let cfg = o.config();
     let domain: UnitSquare = cfg.square();
-    run_continuous(
-        "square",
-        &domain,
-        |r: &mut Rng| s.sample(r.next_2d()),
-        |p| s.pdf(p),
-        &cfg,
-        vec![],
-    )
+    let sample = |r: &mut Rng| s.sample(r.next_2d());
+    run_continuous("square", &domain, sample, |p| s.pdf(p), &cfg, vec![])
 }
 
 impl Outcome {

@@ -80,7 +80,7 @@ fn run_chi2(f: &parse::TestFile, a: &TestArgs) -> Result<bool, String> {
     for b in &f.bsdfs {
         for k in 0..f.test_count {
             let wi = square_to_cosine_hemisphere(rng.next_2d());
-            let name = format!("line{}-{}/wi{k}", b.line, ty_of(&b.label));
+            let name = format!("line{}-{}/wi{k}", b.line, b.value.kind.type_name());
             let about = format!("{} sampled for wi = {wi}", b.label);
             let m = b.value.clone();
             let label = name.clone();
@@ -103,9 +103,4 @@ fn run_chi2(f: &parse::TestFile, a: &TestArgs) -> Result<bool, String> {
     };
     let stem = f.path.file_stem().unwrap_or_default().to_string_lossy();
     run_cases(&cases, &cfg, f.alpha, &a.out.join(stem.as_ref()))
-}
-
-/// The type in an item label ("bsdf 'microfacet' (line 12)" -> "microfacet").
-fn ty_of(label: &str) -> &str {
-    label.split('\'').nth(1).unwrap_or("bsdf")
 }
