@@ -1,5 +1,6 @@
 //! Command-line interface.
 
+use crate::experiment::args::SweepArgs;
 use crate::film;
 use crate::integrator::{Strategy, StrategyOverrides};
 use crate::render::{render, RenderSettings};
@@ -27,6 +28,16 @@ pub enum Command {
     /// Run the study's figures (experiments fig1, fig2, fig3), the samplers' (fig4) and
     /// their test integrands, and write their reports.
     Reproduce(ReproduceArgs),
+    /// Split an experiment into fixed units (reference chunks, sweep runs, equal-time runs)
+    /// for `run --shard I/N`; writes <out>/<name>/plan.json.
+    Plan(crate::experiment::shard::cli::PlanArgs),
+    /// Combine the units of sharded runs, exactly and in plan order, into the reference,
+    /// results.csv, figures and report a one-machine run writes.
+    Merge(crate::experiment::shard::cli::MergeArgs),
+    /// List the done, missing and damaged units of a sharded run and the shards to rerun.
+    Status(crate::experiment::shard::cli::StatusArgs),
+    /// Run experiments on a Slurm cluster (job arrays of shards, then a merge).
+    Slurm(crate::slurm::SlurmArgs),
     /// Measure render throughput per strategy and thread count.
     Bench(crate::bench::BenchArgs),
     /// Chi-square tests of every sampling routine against its pdf (warps, BSDFs, emitters),
@@ -43,25 +54,6 @@ pub enum Command {
     Extreme(ExtremeArgs),
 }
 
-/// Options shared by `run` and `reproduce`.
-#[derive(Args, Debug, Clone)]
-pub struct SweepArgs {
-    /// Small resolution and spp from each file's [quick] table (tests, smoke runs); written
-    /// to `<name>-quick`.
-    #[arg(long)]
-    pub quick: bool,
-    /// Reports folder; each experiment writes into `<out>/<name>/`.
-    #[arg(long, default_value = "reports")]
-    pub out: PathBuf,
-    /// Worker threads (default: all cores). Images do not depend on it; timings do.
-    #[arg(long, value_parser = crate::render::parse_threads)]
-    pub threads: Option<usize>,
-    /// Render the references again even if the cache has them (after upgrading a
-    /// dependency; changes to the renderer's own source are detected).
-    #[arg(long)]
-    pub fresh_reference: bool,
-}
-
 #[derive(Args, Debug)]
 pub struct RunArgs {
     /// Experiment files (TOML).
@@ -72,6 +64,8 @@ pub struct RunArgs {
     pub all: bool,
     #[command(flatten)]
     pub sweep: SweepArgs,
+    #[command(flatten)]
+    pub shard: crate::experiment::shard::cli::ShardArgs,
 }
 
 #[derive(Args, Debug)]
@@ -128,7 +122,10 @@ fn cmd_run(a: &RunArgs) -> Result<(), String> {
     } else {
         a.experiments.clone()
     };
-    run_files(&files, &a.sweep)
+    match a.shard.shard {
+        Some(s) => crate::experiment::shard::cli::cmd_run_shard(&files, &a.sweep, s, a.shard.stage),
+        None => run_files(&files, &a.sweep),
+    }
 }
 
 fn cmd_extreme(a: &ExtremeArgs) -> Result<(), String> {
@@ -341,6 +338,10 @@ pub fn main() -> i32 {
                 .ok_or_else(|| "some sampling routines do not match their pdfs".to_string())
         }),
         Command::Extreme(a) => cmd_extreme(a),
+        Command::Plan(a) => crate::experiment::shard::cli::cmd_plan(a),
+        Command::Merge(a) => crate::experiment::shard::cli::cmd_merge(a),
+        Command::Status(a) => crate::experiment::shard::cli::cmd_status(a),
+        Command::Slurm(a) => crate::slurm::run(a),
         Command::Test(a) => crate::noritest::run(a).and_then(|ok| {
             ok.then_some(())
                 .ok_or_else(|| "some tests failed (see the tables above)".to_string())

@@ -27,4 +27,5 @@ pub mod rng;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod slurm;
 pub mod stats;

@@ -116,19 +116,42 @@ fn parent_dir(target: &Path) -> Result<PathBuf, String> {
     Ok(dir)
 }
 
-/// A sibling path for the temporary file, in the same directory so rename is atomic.
+/// A sibling path for the temporary file, in the same directory so rename is atomic. Named
+/// by pid and host: on a shared file system (cluster shards) a pid alone says nothing about
+/// a writer on another node.
 fn temp_path(target: &Path) -> PathBuf {
     let mut name = target
         .file_name()
         .map(|n| n.to_os_string())
         .unwrap_or_default();
-    name.push(format!(".tmp{}", std::process::id()));
+    name.push(format!(".tmp{}@{}", std::process::id(), host()));
     target.with_file_name(name)
 }
 
-/// The pid in a temporary file's name (`<anything>.tmp<digits>`).
+/// This machine's host name ("" if it has none), as it appears in temporary file names.
+fn host() -> String {
+    let mut buf = [0u8; 256];
+    // SAFETY: the buffer is valid for its length; gethostname NUL-terminates within it or
+    // truncates, and the result is read up to the first NUL only.
+    let ok = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len() - 1) } == 0;
+    let end = buf.iter().position(|&b| b == 0).unwrap_or(0);
+    if ok {
+        String::from_utf8_lossy(&buf[..end]).replace(['/', '@'], "_")
+    } else {
+        String::new()
+    }
+}
+
+/// The pid in a temporary file's name (`<anything>.tmp<digits>` or
+/// `<anything>.tmp<digits>@<host>`), when it was written on this host: another host's
+/// writer cannot be checked from here, so its file is left alone.
 fn temp_pid(name: &str) -> Option<u32> {
-    let (_, digits) = name.rsplit_once(".tmp")?;
+    let (_, tail) = name.rsplit_once(".tmp")?;
+    let digits = match tail.split_once('@') {
+        Some((d, h)) if h == host() => d,
+        Some(_) => return None,
+        None => tail,
+    };
     if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
         return None;
     }
@@ -351,9 +374,14 @@ mod tests {
         std::fs::write(&mine, "in flight").unwrap();
         let unrelated = dir.join("notes.tmp");
         std::fs::write(&unrelated, "user's").unwrap();
+        let dead_here = dir.join(format!("b.exr.tmp4194305@{}", host()));
+        std::fs::write(&dead_here, "half").unwrap();
+        // Written by a node sharing the file system: its pid cannot be checked from here.
+        let other_host = dir.join("c.exr.tmp4194305@elsewhere-node");
+        std::fs::write(&other_host, "in flight there").unwrap();
         put(&dir.join("img.exr"), "new").unwrap();
-        assert!(!dead.exists());
-        assert!(mine.exists() && unrelated.exists());
+        assert!(!dead.exists() && !dead_here.exists());
+        assert!(mine.exists() && unrelated.exists() && other_host.exists());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -164,21 +164,36 @@ pub struct ReferenceRequest<'a> {
     pub progress: bool,
 }
 
+/// The reference cached in `dir` under `key`, with its floors for `eps`.
+pub fn cached(dir: &Path, key: &str, eps: f64) -> Option<Reference> {
+    let (mean, variance, mut info) = load(dir, key)?;
+    // The floor depends on epsilon, which is not part of the key.
+    let (m, r) = noise_floor(&mean, &variance, eps);
+    info.mse_floor = m;
+    info.relmse_floor = r;
+    info.relmse_epsilon = eps;
+    Some(Reference {
+        mean,
+        variance,
+        info,
+        cached: true,
+    })
+}
+
+/// What a reference is, apart from its pixels.
+pub struct Identity<'a> {
+    pub key: &'a str,
+    pub strategy: &'a Strategy,
+    pub spp: u32,
+    pub seed: u64,
+    pub relmse_epsilon: f64,
+}
+
 /// The cached reference for `req.key`, or a new render stored under it.
 pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, String> {
     if !req.fresh {
-        if let Some((mean, variance, mut info)) = load(dir, &req.key) {
-            // The floor depends on epsilon, which is not part of the key.
-            let (m, r) = noise_floor(&mean, &variance, req.relmse_epsilon);
-            info.mse_floor = m;
-            info.relmse_floor = r;
-            info.relmse_epsilon = req.relmse_epsilon;
-            return Ok(Reference {
-                mean,
-                variance,
-                info,
-                cached: true,
-            });
+        if let Some(r) = cached(dir, &req.key, req.relmse_epsilon) {
+            return Ok(r);
         }
     }
     eprintln!(
@@ -199,43 +214,69 @@ pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, St
             key: &req.key,
         },
     )?;
-    let (mean, variance) = acc.images();
-    let out = crate::render::RenderOutput {
-        mean,
-        variance,
-        spp: req.spp,
-        seconds: acc.seconds,
-        busy_seconds: acc.seconds,
-        non_finite_samples: acc.non_finite_samples,
-    };
-    let (mse_floor, relmse_floor) = noise_floor(&out.mean, &out.variance, req.relmse_epsilon);
+    store(
+        dir,
+        &Identity {
+            key: &req.key,
+            strategy: &req.strategy,
+            spp: req.spp,
+            seed: req.seed,
+            relmse_epsilon: req.relmse_epsilon,
+        },
+        &acc,
+    )
+}
+
+/// Stores the merged statistics `acc` of reference `id` in the cache (the JSON last: its
+/// presence marks a complete entry) and removes references of other keys.
+pub fn store(dir: &Path, id: &Identity, acc: &super::chunks::Accum) -> Result<Reference, String> {
+    let (mut mean, mut variance) = acc.images();
+    // The EXR holds f32: measure against what is stored, so a run that renders the
+    // reference and one that reads it from the cache (or from merged shards) agree exactly.
+    for p in mean.data.iter_mut().chain(variance.data.iter_mut()) {
+        *p = p.map(|v| v as f32 as f64);
+    }
+    let (mse_floor, relmse_floor) = noise_floor(&mean, &variance, id.relmse_epsilon);
     let info = ReferenceInfo {
-        key: req.key.clone(),
+        key: id.key.to_string(),
         renderer: RENDERER_HASH.to_string(),
-        strategy: req.strategy.label(),
-        spp: req.spp,
-        seed: req.seed,
-        seconds: out.seconds,
-        non_finite_samples: out.non_finite_samples,
+        strategy: id.strategy.label(),
+        spp: id.spp,
+        seed: id.seed,
+        seconds: acc.seconds,
+        non_finite_samples: acc.non_finite_samples,
         mse_floor,
         relmse_floor,
-        relmse_epsilon: req.relmse_epsilon,
+        relmse_epsilon: id.relmse_epsilon,
     };
-    let (m, v, j) = paths(dir, &req.key);
-    film::write_exr(&m, &out.mean)?;
-    film::write_exr(&v, &out.variance)?;
-    // The JSON goes last: its presence marks a complete entry.
+    let (m, v, j) = paths(dir, id.key);
+    film::write_exr(&m, &mean)?;
+    film::write_exr(&v, &variance)?;
+    let chunks = super::chunks::chunk_ranges(id.spp).len() as u32;
+    // Without its render time (the JSON has it), so equal statistics are equal bytes.
+    let timeless = super::chunks::Accum {
+        seconds: 0.0,
+        ..acc.clone()
+    };
+    super::chunks::save(&stats_path(dir, id.key), id.key, chunks, &timeless)?;
     let json = serde_json::to_string_pretty(&info).map_err(|e| e.to_string())?;
     crate::output::write_atomic(&j, |tmp| {
         std::fs::write(tmp, json).map_err(|e| format!("{}: {e}", j.display()))
     })?;
-    prune(dir, &req.key);
+    prune(dir, id.key);
     Ok(Reference {
-        mean: out.mean,
-        variance: out.variance,
+        mean,
+        variance,
         info,
         cached: false,
     })
+}
+
+/// The per-pixel count, mean and M2 in f64 of the reference cached under `key` (EXR holds
+/// f32): what a longer reference could be merged onto, and what shows that two ways of
+/// rendering it agree bit for bit.
+pub fn stats_path(dir: &Path, key: &str) -> PathBuf {
+    dir.join(format!("reference-{key}.f64"))
 }
 
 /// A closed-form reference: `value` in every pixel and channel, with no noise (floors 0).

@@ -98,22 +98,105 @@ pub fn checkpoint_path(dir: &Path, key: &str) -> PathBuf {
     dir.join(format!("reference-{key}.partial"))
 }
 
-/// Writes `acc` after `chunks` chunks (atomically: a checkpoint is whole or absent).
-fn save(path: &Path, key: &str, chunks: u32, acc: &Accum) -> Result<(), String> {
-    let mut b = Vec::with_capacity(64 + acc.mean.len() * 48);
-    b.extend_from_slice(MAGIC);
-    b.extend_from_slice(&(key.len() as u32).to_le_bytes());
-    b.extend_from_slice(key.as_bytes());
-    for v in [chunks as u64, acc.width as u64, acc.height as u64, acc.n] {
-        b.extend_from_slice(&v.to_le_bytes());
-    }
-    b.extend_from_slice(&acc.seconds.to_le_bytes());
-    b.extend_from_slice(&acc.non_finite_samples.to_le_bytes());
-    for p in acc.mean.iter().chain(&acc.m2) {
-        for v in p {
+impl Accum {
+    /// Appends the film size, counts and the f64 statistics, little-endian.
+    pub fn encode(&self, b: &mut Vec<u8>) {
+        for v in [self.width as u64, self.height as u64, self.n] {
             b.extend_from_slice(&v.to_le_bytes());
         }
+        b.extend_from_slice(&self.seconds.to_le_bytes());
+        b.extend_from_slice(&self.non_finite_samples.to_le_bytes());
+        for p in self.mean.iter().chain(&self.m2) {
+            for v in p {
+                b.extend_from_slice(&v.to_le_bytes());
+            }
+        }
     }
+
+    /// Reads what [`Accum::encode`] wrote from `r`; None if it is cut short or the film is
+    /// implausibly large for the bytes there.
+    pub fn decode(r: &mut Reader) -> Option<Accum> {
+        let (w, h, n) = (r.u64()?, r.u64()?, r.u64()?);
+        let seconds = f64::from_bits(r.u64()?);
+        let non_finite_samples = r.u64()?;
+        let pixels = w.checked_mul(h)? as usize;
+        if pixels.checked_mul(48)? > r.left() {
+            return None;
+        }
+        let mut read = || -> Option<Vec<[f64; 3]>> {
+            (0..pixels)
+                .map(|_| Some([r.f64()?, r.f64()?, r.f64()?]))
+                .collect()
+        };
+        let mean = read()?;
+        let m2 = read()?;
+        Some(Accum {
+            width: u32::try_from(w).ok()?,
+            height: u32::try_from(h).ok()?,
+            n,
+            mean,
+            m2,
+            seconds,
+            non_finite_samples,
+        })
+    }
+}
+
+/// A cursor over little-endian bytes.
+pub struct Reader<'a> {
+    b: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    pub fn new(b: &'a [u8]) -> Self {
+        Reader { b, at: 0 }
+    }
+
+    pub fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+        let s = self.b.get(self.at..self.at.checked_add(n)?)?;
+        self.at += n;
+        Some(s)
+    }
+
+    pub fn u64(&mut self) -> Option<u64> {
+        Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
+    }
+
+    pub fn u32(&mut self) -> Option<u32> {
+        Some(u32::from_le_bytes(self.take(4)?.try_into().ok()?))
+    }
+
+    pub fn f64(&mut self) -> Option<f64> {
+        self.u64().map(f64::from_bits)
+    }
+
+    /// A u32-length-prefixed byte string.
+    pub fn bytes(&mut self) -> Option<&'a [u8]> {
+        let n = self.u32()? as usize;
+        self.take(n)
+    }
+
+    /// Bytes not read yet.
+    pub fn left(&self) -> usize {
+        self.b.len() - self.at
+    }
+}
+
+/// Appends a u32-length-prefixed byte string.
+pub fn put_bytes(b: &mut Vec<u8>, s: &[u8]) {
+    b.extend_from_slice(&(s.len() as u32).to_le_bytes());
+    b.extend_from_slice(s);
+}
+
+/// Writes `acc` after `chunks` chunks (atomically: a checkpoint is whole or absent). A
+/// finished reference keeps its statistics in the same format (`cache::stats_path`).
+pub fn save(path: &Path, key: &str, chunks: u32, acc: &Accum) -> Result<(), String> {
+    let mut b = Vec::with_capacity(64 + acc.mean.len() * 48);
+    b.extend_from_slice(MAGIC);
+    put_bytes(&mut b, key.as_bytes());
+    b.extend_from_slice(&(chunks as u64).to_le_bytes());
+    acc.encode(&mut b);
     crate::output::write_atomic(path, |tmp| {
         std::fs::write(tmp, &b).map_err(|e| format!("{}: {e}", path.display()))
     })
@@ -123,56 +206,52 @@ fn save(path: &Path, key: &str, chunks: u32, acc: &Accum) -> Result<(), String> 
 /// else (absent, another key, truncated) is None and the render starts over.
 fn load(path: &Path, key: &str, width: u32, height: u32) -> Option<(u32, Accum)> {
     let b = std::fs::read(path).ok()?;
-    let mut at = 0usize;
-    let mut take = |n: usize| -> Option<&[u8]> {
-        let s = b.get(at..at + n)?;
-        at += n;
-        Some(s)
-    };
-    if take(8)? != MAGIC {
+    let mut r = Reader::new(&b);
+    if r.take(8)? != MAGIC || r.bytes()? != key.as_bytes() {
         return None;
     }
-    let klen = u32::from_le_bytes(take(4)?.try_into().ok()?) as usize;
-    if take(klen)? != key.as_bytes() {
+    let chunks = r.u64()?;
+    let acc = Accum::decode(&mut r)?;
+    if (acc.width, acc.height) != (width, height) || r.left() != 0 {
         return None;
     }
-    let mut u64s = [0u64; 4];
-    for v in &mut u64s {
-        *v = u64::from_le_bytes(take(8)?.try_into().ok()?);
-    }
-    let [chunks, w, h, n] = u64s;
-    if (w, h) != (width as u64, height as u64) {
-        return None;
-    }
-    let seconds = f64::from_le_bytes(take(8)?.try_into().ok()?);
-    let non_finite_samples = u64::from_le_bytes(take(8)?.try_into().ok()?);
-    let pixels = (w * h) as usize;
-    let mut read = |count: usize| -> Option<Vec<[f64; 3]>> {
-        (0..count)
-            .map(|_| {
-                let mut p = [0.0; 3];
-                for v in &mut p {
-                    *v = f64::from_le_bytes(take(8)?.try_into().ok()?);
-                }
-                Some(p)
-            })
-            .collect()
-    };
-    let mean = read(pixels)?;
-    let m2 = read(pixels)?;
-    if at != b.len() {
-        return None;
-    }
-    let acc = Accum {
-        width,
-        height,
-        n,
-        mean,
-        m2,
-        seconds,
-        non_finite_samples,
-    };
-    Some((chunks as u32, acc))
+    Some((u32::try_from(chunks).ok()?, acc))
+}
+
+/// The fixed chunks of a reference of `spp` samples per pixel: (first sample, spp) each, in
+/// merge order. A plain run and every shard of a cluster run cut the same chunks.
+pub fn chunk_ranges(spp: u32) -> Vec<(u64, u32)> {
+    (0..spp.div_ceil(CHUNK_SPP) as u64)
+        .map(|k| {
+            let first = k * CHUNK_SPP as u64;
+            (first, (spp as u64 - first).min(CHUNK_SPP as u64) as u32)
+        })
+        .collect()
+}
+
+/// Renders one chunk: samples `first .. first + spp` of every pixel's stream.
+pub fn render_chunk(
+    scene: &Scene,
+    strategy: Strategy,
+    seed: u64,
+    (first, spp): (u64, u32),
+    threads: Option<usize>,
+    progress: bool,
+) -> Accum {
+    Accum::of(&render(
+        scene,
+        strategy,
+        &RenderSettings {
+            spp,
+            seed,
+            first_sample: first,
+            threads,
+            progress,
+            // References draw independent samples: their chunks merge as independent
+            // estimates whatever the sweep's samplers.
+            sampling: Default::default(),
+        },
+    ))
 }
 
 /// What a chunked reference render needs.
@@ -191,7 +270,8 @@ pub struct ChunkedRender<'a> {
 /// is there, and removes the checkpoint when done.
 pub fn render_chunked(dir: &Path, r: &ChunkedRender) -> Result<Accum, String> {
     let (w, h) = (r.scene.camera.width, r.scene.camera.height);
-    let chunks = r.spp.div_ceil(CHUNK_SPP);
+    let ranges = chunk_ranges(r.spp);
+    let chunks = ranges.len() as u32;
     let path = checkpoint_path(dir, r.key);
     let (mut done, mut acc) = match load(&path, r.key, w, h) {
         Some((k, acc)) if k < chunks => {
@@ -202,24 +282,8 @@ pub fn render_chunked(dir: &Path, r: &ChunkedRender) -> Result<Accum, String> {
         }
         _ => (0, None),
     };
-    while done < chunks {
-        let first = done as u64 * CHUNK_SPP as u64;
-        let spp = (r.spp as u64 - first).min(CHUNK_SPP as u64) as u32;
-        let out = render(
-            r.scene,
-            r.strategy,
-            &RenderSettings {
-                spp,
-                seed: r.seed,
-                first_sample: first,
-                threads: r.threads,
-                progress: r.progress,
-                // References draw independent samples: their chunks merge as independent
-                // estimates whatever the sweep's samplers.
-                sampling: Default::default(),
-            },
-        );
-        let chunk = Accum::of(&out);
+    for &range in &ranges[done as usize..] {
+        let chunk = render_chunk(r.scene, r.strategy, r.seed, range, r.threads, r.progress);
         match &mut acc {
             Some(a) => a.merge(&chunk),
             None => acc = Some(chunk),

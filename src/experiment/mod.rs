@@ -2,6 +2,7 @@
 //! resumable results, left-out analysis, figures and a report per experiment.
 
 pub mod analysis;
+pub mod args;
 pub mod cache;
 pub mod cases;
 pub mod chunks;
@@ -15,6 +16,7 @@ pub mod resolve;
 pub mod results;
 pub mod runner;
 pub mod schema;
+pub mod shard;
 mod validate;
 
 pub use resolve::load;
@@ -29,11 +31,15 @@ pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(),
     if exp.exp.probe.is_some() {
         return probe::run_and_report(exp, opts);
     }
-    let o = run_experiment(exp, opts)?;
-    let (series, mut figs) = figures::charts(&o)?;
-    figs.extend(figures::images(&o)?);
-    crate::report::write_experiment(&o, &series, &figs)?;
-    for l in crate::report::mean_check_lines(&o) {
+    report_outcome(&run_experiment(exp, opts)?)
+}
+
+/// Writes the figures and report of a finished sweep and prints its summary.
+pub fn report_outcome(o: &Outcome) -> Result<(), String> {
+    let (series, mut figs) = figures::charts(o)?;
+    figs.extend(figures::images(o)?);
+    crate::report::write_experiment(o, &series, &figs)?;
+    for l in crate::report::mean_check_lines(o) {
         println!("{}: {l}", o.exp.name);
     }
     println!(

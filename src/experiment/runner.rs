@@ -12,7 +12,7 @@ use super::results::{Results, Row, EQUAL_TIME};
 use super::schema::{EqualTimeSpec, Resolved};
 use crate::film;
 use crate::integrator::Strategy;
-use crate::render::{render, RenderSettings};
+use crate::render::{render, RenderOutput, RenderSettings};
 use crate::scene::Scene;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -48,15 +48,26 @@ pub struct Outcome {
     pub direct_part_of: Option<String>,
 }
 
-struct Ctx<'a> {
-    scene: &'a Scene,
-    reference: &'a Reference,
-    eps: f64,
-    context: String,
-    threads: Option<usize>,
+pub(crate) struct Ctx<'a> {
+    pub(crate) scene: &'a Scene,
+    pub(crate) reference: &'a Reference,
+    pub(crate) eps: f64,
+    pub(crate) context: String,
+    pub(crate) threads: Option<usize>,
 }
 
-fn execute(ctx: &Ctx, job: &Job) -> Result<Row, String> {
+/// Renders `job` and measures it; keeps its image where the job says.
+pub(crate) fn execute(ctx: &Ctx, job: &Job) -> Result<Row, String> {
+    let (row, out) = render_job(ctx, job)?;
+    if let Some(p) = &job.image {
+        film::write_exr(p, &out.mean)?;
+        film::write_exr(&variance_path(p), &out.variance)?;
+    }
+    Ok(row)
+}
+
+/// Renders `job` and measures it against the reference.
+pub(crate) fn render_job(ctx: &Ctx, job: &Job) -> Result<(Row, RenderOutput), String> {
     let settings = RenderSettings {
         spp: job.spp,
         seed: job.seed,
@@ -70,11 +81,10 @@ fn execute(ctx: &Ctx, job: &Job) -> Result<Row, String> {
         .sampler_config((cam.width, cam.height))
         .map_err(|e| format!("{} at {} spp: {e}", job.method.label(), job.spp))?;
     let out = render(ctx.scene, job.method.strategy, &settings);
-    if let Some(p) = &job.image {
-        film::write_exr(p, &out.mean)?;
-        film::write_exr(&variance_path(p), &out.variance)?;
-    }
-    Ok(measure(ctx.reference, ctx.eps, &ctx.context, job, &out))
+    Ok((
+        measure(ctx.reference, ctx.eps, &ctx.context, job, &out),
+        out,
+    ))
 }
 
 fn progress_bar(total_samples: u64, runs: usize) -> ProgressBar {
@@ -95,40 +105,35 @@ fn progress_bar(total_samples: u64, runs: usize) -> ProgressBar {
 
 /// The cached reference, or a new render; prints where it came from and its noise floor.
 fn rendered_reference(
-    exp: &Resolved,
+    s: &Setup,
     opts: &RunOptions,
-    scene: &Scene,
     strategy: Strategy,
     spp: u32,
-    eps: f64,
-    dir: &Path,
-) -> Result<(String, Reference), String> {
-    let seed = exp.exp.reference.seed;
-    let key = cache::reference_key(&KeyInputs {
-        scene: exp.scene(),
-        defines: exp.defines(),
-        spp,
-        seed,
-        strategy: &strategy,
-    })?;
+    seed: u64,
+) -> Result<Reference, String> {
     let reference = cache::get_or_render(
-        &dir.join("cache"),
+        &s.dir.join("cache"),
         &ReferenceRequest {
-            scene,
-            key: key.clone(),
+            scene: &s.scene,
+            key: s.key.clone(),
             strategy,
             spp,
             seed,
             threads: opts.threads,
-            relmse_epsilon: eps,
+            relmse_epsilon: s.eps,
             fresh: opts.fresh_reference,
             progress: std::io::stderr().is_terminal(),
         },
     )?;
+    print_reference(&s.exp.name, &reference);
+    Ok(reference)
+}
+
+/// Says where the reference came from and its noise floor.
+pub(crate) fn print_reference(name: &str, reference: &Reference) {
     let ri = &reference.info;
     eprintln!(
-        "{}: reference {} at {} spp ({}, {:.1} s to render); noise floor MSE {:.3e}, relMSE {:.3e}",
-        exp.name,
+        "{name}: reference {} at {} spp ({}, {:.1} s to render); noise floor MSE {:.3e}, relMSE {:.3e}",
         ri.strategy,
         ri.spp,
         if reference.cached {
@@ -140,11 +145,10 @@ fn rendered_reference(
         ri.mse_floor,
         ri.relmse_floor
     );
-    Ok((key, reference))
 }
 
 /// Columns (strategy and sampler) with their legend names.
-type Named = Vec<(String, Method)>;
+pub(crate) type Named = Vec<(String, Method)>;
 
 /// The experiment's strategies on the scene's settings `base`, without those that are the
 /// same estimator on this scene or cannot see its light (each said on stderr), crossed with
@@ -193,11 +197,7 @@ fn equal_time_jobs(
                 // and the figure show the same render.
                 let spp = match old {
                     Some(r) => r.spp,
-                    None => {
-                        let r = rate(&results.rows, &label)
-                            .ok_or_else(|| format!("no sweep rows for {label} to time it from"))?;
-                        ((budget * r / pixels as f64).round() as u32).max(1)
-                    }
+                    None => equal_time_spp(&results.rows, &label, budget, pixels)?,
                 };
                 timed.push(Job {
                     name: name.clone(),
@@ -214,8 +214,83 @@ fn equal_time_jobs(
     Ok(timed)
 }
 
-pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, String> {
-    let start = Instant::now();
+/// Where an experiment's reference comes from.
+pub(crate) enum RefSource {
+    /// A closed-form value in every pixel.
+    Constant(f64),
+    /// Rendered by `strategy` at `spp` from `seed`, in [`super::chunks`]' fixed chunks.
+    Rendered {
+        strategy: Strategy,
+        spp: u32,
+        seed: u64,
+    },
+}
+
+/// What every way of running an image sweep needs before it renders: the scene, the kept
+/// strategies and the reference's identity. One machine ([`run_experiment`]) and shards
+/// ([`super::shard`]) start from it.
+pub(crate) struct Setup {
+    pub(crate) exp: Resolved,
+    pub(crate) dir: PathBuf,
+    pub(crate) scene: Scene,
+    pub(crate) kept: Named,
+    pub(crate) omitted: Vec<Omission>,
+    pub(crate) eps: f64,
+    pub(crate) source: RefSource,
+    /// The reference's cache key.
+    pub(crate) key: String,
+    /// Rows measured against this reference and epsilon carry it (`Row::context`).
+    pub(crate) context: String,
+}
+
+impl Setup {
+    /// spp values whose seed-0 image the figures need.
+    pub(crate) fn keep_spp(&self) -> Vec<u32> {
+        let mut keep: Vec<u32> = self.exp.exp.figures.progression.clone();
+        keep.push(self.exp.equal_spp());
+        keep.push(self.exp.variance_spp());
+        keep
+    }
+
+    pub(crate) fn pixels(&self) -> u64 {
+        self.scene.camera.width as u64 * self.scene.camera.height as u64
+    }
+
+    /// The sweep's renders `results` does not hold yet, in the fixed plan order.
+    pub(crate) fn sweep_jobs(&self, results: &Results) -> Vec<Job> {
+        let x = &self.exp.exp;
+        plan_sweep(
+            results,
+            &self.kept,
+            &Sweep {
+                spp: &x.spp,
+                seeds: x.seeds,
+                keep_spp: &self.keep_spp(),
+                dir: &self.dir,
+            },
+        )
+    }
+
+    /// The cached reference, rendered now if the cache lacks it.
+    fn reference(&self, opts: &RunOptions) -> Result<Reference, String> {
+        match self.source {
+            RefSource::Constant(v) => Ok(cache::constant(
+                self.scene.camera.width,
+                self.scene.camera.height,
+                v,
+                self.key.clone(),
+            )),
+            RefSource::Rendered {
+                strategy,
+                spp,
+                seed,
+            } => rendered_reference(self, opts, strategy, spp, seed),
+        }
+    }
+}
+
+/// Loads the scene, leaves out what it does not need and fixes the reference's key.
+pub(crate) fn setup(exp: Resolved, opts: &RunOptions) -> Result<Setup, String> {
     let dir = opts.out.join(&exp.name);
     let scene = crate::scene::open_with(exp.scene(), exp.defines(), exp.cases[0].integrator)?;
     let base = Strategy::from_desc(&scene.desc.integrator);
@@ -232,27 +307,93 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
             .map_err(|e| format!("{}: samplers: {e}", exp.file.display()))?;
     }
     let eps = x.metrics.relmse_epsilon;
-    let ref_strategy = x
-        .reference
-        .strategy
-        .apply(base)
-        .map_err(|e| format!("[reference]: {e}"))?;
-    let (key, reference) = match (exp.cases[0].value, x.reference.spp) {
-        (Some(v), _) => {
-            let key = cache::constant_key(exp.scene(), exp.defines(), v, &base)?;
-            let r = cache::constant(scene.camera.width, scene.camera.height, v, key.clone());
-            (key, r)
+    let (key, source) = match (exp.cases[0].value, x.reference.spp) {
+        (Some(v), _) => (
+            cache::constant_key(exp.scene(), exp.defines(), v, &base)?,
+            RefSource::Constant(v),
+        ),
+        (None, Some(spp)) => {
+            let strategy = x
+                .reference
+                .strategy
+                .apply(base)
+                .map_err(|e| format!("[reference]: {e}"))?;
+            let seed = x.reference.seed;
+            let key = cache::reference_key(&KeyInputs {
+                scene: exp.scene(),
+                defines: exp.defines(),
+                spp,
+                seed,
+                strategy: &strategy,
+            })?;
+            (
+                key,
+                RefSource::Rendered {
+                    strategy,
+                    spp,
+                    seed,
+                },
+            )
         }
-        (None, Some(spp)) => rendered_reference(&exp, opts, &scene, ref_strategy, spp, eps, &dir)?,
         (None, None) => unreachable!("validated: a reference is rendered or given"),
     };
     let mut h = Fnv::new();
     h.field(key.as_bytes()).field(&eps.to_le_bytes());
-    let ctx = Ctx {
-        scene: &scene,
-        reference: &reference,
-        eps,
+    Ok(Setup {
         context: h.hex(),
+        exp,
+        dir,
+        scene,
+        kept,
+        omitted,
+        eps,
+        source,
+        key,
+    })
+}
+
+impl Outcome {
+    /// The outcome of `rows` measured in `s` against `reference`.
+    pub(crate) fn of(s: Setup, reference: Reference, rows: Vec<Row>, start: Instant) -> Outcome {
+        Outcome {
+            strategies: s.kept.iter().map(|(n, m)| (m.label(), n.clone())).collect(),
+            omitted: s.omitted,
+            rows,
+            rendered: 0,
+            dropped_rows: 0,
+            seconds: start.elapsed().as_secs_f64(),
+            width: s.scene.camera.width,
+            height: s.scene.camera.height,
+            direct_part_of: s.scene.desc.integrator.direct_part_of.clone(),
+            dir: s.dir,
+            exp: s.exp,
+            reference,
+        }
+    }
+}
+
+/// The spp that `budget` seconds buy `label` at the rate its sweep rows measured.
+pub(crate) fn equal_time_spp(
+    rows: &[Row],
+    label: &str,
+    budget: f64,
+    pixels: u64,
+) -> Result<u32, String> {
+    let r =
+        rate(rows, label).ok_or_else(|| format!("no sweep rows for {label} to time it from"))?;
+    Ok(((budget * r / pixels as f64).round() as u32).max(1))
+}
+
+pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, String> {
+    let start = Instant::now();
+    let s = setup(exp, opts)?;
+    let reference = s.reference(opts)?;
+    let (exp, dir, x) = (&s.exp, &s.dir, &s.exp.exp);
+    let ctx = Ctx {
+        scene: &s.scene,
+        reference: &reference,
+        eps: s.eps,
+        context: s.context.clone(),
         threads: opts.threads,
     };
     let csv = dir.join("results.csv");
@@ -264,20 +405,9 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
         );
     }
 
-    let pixels = scene.camera.width as u64 * scene.camera.height as u64;
-    let mut keep_spp: Vec<u32> = x.figures.progression.clone();
-    keep_spp.push(exp.equal_spp());
-    keep_spp.push(exp.variance_spp());
-    let jobs = plan_sweep(
-        &results,
-        &kept,
-        &Sweep {
-            spp: &x.spp,
-            seeds: x.seeds,
-            keep_spp: &keep_spp,
-            dir: &dir,
-        },
-    );
+    let pixels = s.pixels();
+    let jobs = s.sweep_jobs(&results);
+    let kept = &s.kept;
     let equal_time_runs = x
         .equal_time
         .as_ref()
@@ -305,7 +435,7 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
     }
 
     let timed = match &x.equal_time {
-        Some(et) => equal_time_jobs(et, &kept, &results, &dir, pixels)?,
+        Some(et) => equal_time_jobs(et, kept, &results, dir, pixels)?,
         None => Vec::new(),
     };
     bar.inc_length(timed.iter().map(|j| j.spp as u64 * pixels).sum());
@@ -322,18 +452,9 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
             results.rows.len()
         );
     }
-    Ok(Outcome {
-        strategies: kept.iter().map(|(n, s)| (s.label(), n.clone())).collect(),
-        omitted,
-        rows: results.rows,
-        rendered,
-        dropped_rows: results.dropped,
-        seconds: start.elapsed().as_secs_f64(),
-        width: scene.camera.width,
-        height: scene.camera.height,
-        direct_part_of: scene.desc.integrator.direct_part_of.clone(),
-        dir,
-        exp,
-        reference,
-    })
+    let dropped = results.dropped;
+    let mut o = Outcome::of(s, reference, results.rows, start);
+    o.rendered = rendered;
+    o.dropped_rows = dropped;
+    Ok(o)
 }

@@ -32,3 +32,111 @@ pub fn run(cmd: &mut Command) -> Output {
     }
     out
 }
+
+/// A small sweep for the sharding tests (16x16 two-light box, a reference of three chunks,
+/// two strategies x three spp x two seeds, one equal-time budget), written into `dir`.
+pub fn tiny_experiment(dir: &Path, seeds: u32) -> PathBuf {
+    let scene = repo("scenes/cbox-twolights/cbox-twolights.xml");
+    let text = format!(
+        r#"title = "sharding test"
+scene = "{}"
+defines = {{ res = "16" }}
+spp = [1, 4, 16]
+seeds = {seeds}
+
+[reference]
+spp = 2600
+strategy = {{ strategy = "mis", heuristic = "power", emitter_selection = "power" }}
+
+[metrics]
+relmse_epsilon = 0.01
+
+[[strategy]]
+name = "uniform choice"
+strategy = "light"
+emitter_selection = "uniform"
+
+[[strategy]]
+name = "power choice"
+strategy = "light"
+emitter_selection = "power"
+
+[equal_time]
+seconds = [0.02]
+
+[figures]
+equal_spp = 4
+"#,
+        scene.display()
+    );
+    let p = dir.join("tiny.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// The sweep rows of a results.csv without the columns that measure time (seconds,
+/// samples/s): what must be equal however the sweep was split.
+pub fn sweep_rows(csv: &Path) -> Vec<Vec<(String, String)>> {
+    let text = std::fs::read_to_string(csv).unwrap_or_else(|e| panic!("{}: {e}", csv.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    lines
+        .map(|l| {
+            header
+                .iter()
+                .cloned()
+                .zip(l.split(',').map(String::from))
+                .collect::<Vec<_>>()
+        })
+        .filter(|r| r.iter().any(|(k, v)| k == "kind" && v == "spp"))
+        .map(|r| {
+            r.into_iter()
+                .filter(|(k, _)| k != "seconds" && k != "samples_per_s")
+                .collect()
+        })
+        .collect()
+}
+
+/// The reference cached under `<out>/<name>/cache`: its mean image (f32 EXR) and its
+/// per-pixel statistics in f64, as bytes.
+pub fn reference_bytes(exp_dir: &Path) -> (Vec<u8>, Vec<u8>) {
+    let find = |suffix: &str| {
+        std::fs::read_dir(exp_dir.join("cache"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| {
+                let n = p.file_name().unwrap().to_string_lossy().to_string();
+                n.starts_with("reference-") && n.ends_with(suffix) && !n.ends_with("-var.exr")
+            })
+            .unwrap_or_else(|| panic!("no reference*{suffix} in {}", exp_dir.display()))
+    };
+    (
+        std::fs::read(find(".exr")).unwrap(),
+        std::fs::read(find(".f64")).unwrap(),
+    )
+}
+
+/// The units folder of the plan in `exp_dir` and the plan's JSON.
+pub fn plan_of(exp_dir: &Path) -> (PathBuf, serde_json::Value) {
+    let plan: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(exp_dir.join("plan.json")).unwrap()).unwrap();
+    let id = plan["id"].as_str().unwrap().to_string();
+    (exp_dir.join("units").join(id), plan)
+}
+
+/// Every unit file in `units` with its modification time and inode (a rewritten file
+/// changes both).
+pub fn unit_files(units: &Path) -> Vec<(PathBuf, i64, u64)> {
+    use std::os::unix::fs::MetadataExt;
+    let mut v: Vec<_> = std::fs::read_dir(units)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "unit") && p.is_file())
+        .map(|p| {
+            let m = std::fs::metadata(&p).unwrap();
+            (p, m.mtime() * 1_000_000_000 + m.mtime_nsec(), m.ino())
+        })
+        .collect();
+    v.sort();
+    v
+}

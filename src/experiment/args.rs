@@ -1,0 +1,33 @@
+//! Options every command that runs experiments shares.
+
+use super::RunOptions;
+use clap::Args;
+use std::path::PathBuf;
+
+/// Options shared by `run`, `reproduce`, `plan`, `merge`, `status` and `slurm submit`.
+#[derive(Args, Debug, Clone)]
+pub struct SweepArgs {
+    /// Small resolution and spp from each file's [quick] table (tests, smoke runs); written
+    /// to `<name>-quick`.
+    #[arg(long)]
+    pub quick: bool,
+    /// Reports folder; each experiment writes into `<out>/<name>/`.
+    #[arg(long, default_value = "reports")]
+    pub out: PathBuf,
+    /// Worker threads (default: all cores). Images do not depend on it; timings do.
+    #[arg(long, value_parser = crate::render::parse_threads)]
+    pub threads: Option<usize>,
+    /// Render the references again even if the cache has them (after upgrading a
+    /// dependency; changes to the renderer's own source are detected).
+    #[arg(long)]
+    pub fresh_reference: bool,
+}
+
+/// The runner's options from the command line's.
+pub fn options(a: &SweepArgs) -> RunOptions {
+    RunOptions {
+        out: a.out.clone(),
+        threads: a.threads,
+        fresh_reference: a.fresh_reference,
+    }
+}
