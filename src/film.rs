@@ -92,6 +92,15 @@ pub fn linear_to_srgb(v: f64) -> f64 {
     }
 }
 
+/// The display values of the figures: `exposure` times radiance, clamped to [0, 1], through
+/// the sRGB curve (unquantised; [`to_srgb8`] is the same in 8 bits).
+pub fn to_srgb_unit(img: &Image, exposure: f64) -> Vec<[f64; 3]> {
+    img.data
+        .iter()
+        .map(|p| p.map(|c| linear_to_srgb((c * exposure).clamp(0.0, 1.0))))
+        .collect()
+}
+
 /// 8-bit sRGB bytes of an image, clamped to [0, 1] after `exposure` scaling.
 pub fn to_srgb8(img: &Image, exposure: f64) -> Vec<u8> {
     img.data

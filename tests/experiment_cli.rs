@@ -88,6 +88,46 @@ fn quick_experiment_writes_results_plots_report_and_resumes() {
     ] {
         assert!(dir.join(f).exists(), "missing {f}");
     }
+    // The metrics beside MSE and relMSE: a column each, a plot each, and metrics.csv with
+    // one row per run and metric naming its epsilon and tone mapping.
+    for col in [
+        "trimmed_relmse",
+        "mape",
+        "smape",
+        "mape_eps",
+        "ssim_error",
+        "flip",
+        "exposure",
+    ] {
+        assert!(header.split(',').any(|c| c == col), "no column {col}");
+    }
+    for m in ["trimmed-relmse", "mape", "smape", "ssim", "flip"] {
+        assert!(dir.join(format!("convergence-{m}.png")).exists(), "{m}");
+    }
+    let long = std::fs::read_to_string(dir.join("metrics.csv")).unwrap();
+    assert!(long.starts_with(
+        "case,strategy,name,kind,budget_s,spp,seed,metric,epsilon,tone_mapping,value"
+    ));
+    assert_eq!(long.lines().count() - 1, rows.len() * 7, "{long}");
+    for (metric, eps, tm) in [
+        ("mse", "", "linear"),
+        ("relmse", "0.01", "linear"),
+        ("trimmed-relmse", "0.01", "linear"),
+        ("mape", "0.01", "linear"),
+        ("smape", "0.01", "linear"),
+        ("1-ssim", "", "exposure 1; clamp to [0 1]; sRGB"),
+        ("flip", "", "exposure 1; clamp to [0 1]; sRGB"),
+    ] {
+        let line = long
+            .lines()
+            .find(|l| l.contains(&format!(",{metric},{eps},{tm},")))
+            .unwrap_or_else(|| panic!("no {metric} row with eps '{eps}' and '{tm}'"));
+        let v: f64 = line.rsplit(',').next().unwrap().parse().unwrap();
+        assert!(v.is_finite() && v >= 0.0, "{line}");
+        if metric == "1-ssim" || metric == "flip" || metric == "smape" {
+            assert!(v <= 1.0, "{line}");
+        }
+    }
     let index = std::fs::read_to_string(dir.join("index.md")).unwrap();
     assert!(index.contains("## Left out") && index.contains("noise floor"));
     assert!(index.contains("convergence.png"));

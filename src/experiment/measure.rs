@@ -4,12 +4,43 @@
 use super::cache::Reference;
 use super::plan::Job;
 use super::results::Row;
-use crate::metrics;
+use super::schema::{ErrorMetric, Experiment};
+use crate::metrics::{self, flip, pointwise, ssim};
 use crate::render::RenderOutput;
+
+/// What a row measures beside MSE and relMSE.
+#[derive(Clone, Debug)]
+pub(crate) struct Extra {
+    pub(crate) report: Vec<ErrorMetric>,
+    pub(crate) mape_eps: f64,
+    /// Tone mapping of SSIM and FLIP (the figures' exposure).
+    pub(crate) exposure: f64,
+}
+
+impl Extra {
+    pub(crate) fn of(exp: &Experiment) -> Extra {
+        Extra {
+            report: exp.metrics.report.clone(),
+            mape_eps: exp.metrics.mape_epsilon,
+            exposure: exp.figures.exposure.unwrap_or(1.0),
+        }
+    }
+
+    /// Bytes that change when any of it does (part of the rows' context).
+    pub(crate) fn key(&self) -> String {
+        let names: Vec<&str> = self.report.iter().map(|m| m.slug()).collect();
+        format!("{}|{}|{}", names.join(","), self.mape_eps, self.exposure)
+    }
+
+    fn has(&self, m: ErrorMetric) -> bool {
+        self.report.contains(&m)
+    }
+}
 
 pub(crate) fn measure(
     r: &Reference,
     eps: f64,
+    extra: &Extra,
     context: &str,
     job: &Job,
     out: &RenderOutput,
@@ -86,5 +117,28 @@ pub(crate) fn measure(
         z: None,
         max_sample: None,
         top_share: Some(crate::stats::top_share(pixel_err)),
+        trimmed_relmse: extra
+            .has(ErrorMetric::TrimmedRelmse)
+            .then(|| pointwise::trimmed_rel_mse(&out.mean, &r.mean, eps, pointwise::TRIM)),
+        mape: extra
+            .has(ErrorMetric::Mape)
+            .then(|| pointwise::mape(&out.mean, &r.mean, extra.mape_eps)),
+        smape: extra
+            .has(ErrorMetric::Smape)
+            .then(|| pointwise::smape(&out.mean, &r.mean, extra.mape_eps)),
+        mape_eps: (extra.has(ErrorMetric::Mape) || extra.has(ErrorMetric::Smape))
+            .then_some(extra.mape_eps),
+        ssim_error: if extra.has(ErrorMetric::Ssim) {
+            let tm = |i: &crate::film::Image| crate::film::to_srgb_unit(i, extra.exposure);
+            let (w, h) = (out.mean.width as usize, out.mean.height as usize);
+            ssim::ssim(&tm(&out.mean), &tm(&r.mean), w, h).map(|s| 1.0 - s)
+        } else {
+            None
+        },
+        flip: extra
+            .has(ErrorMetric::Flip)
+            .then(|| flip::flip(&out.mean, &r.mean, extra.exposure)),
+        exposure: (extra.has(ErrorMetric::Ssim) || extra.has(ErrorMetric::Flip))
+            .then_some(extra.exposure),
     }
 }

@@ -36,6 +36,7 @@ pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(),
 
 /// Writes the figures and report of a finished sweep and prints its summary.
 pub fn report_outcome(o: &Outcome) -> Result<(), String> {
+    results::write_long(&o.dir.join("metrics.csv"), &o.rows)?;
     let (series, mut figs) = figures::charts(o)?;
     figs.extend(figures::images(o)?);
     crate::report::write_experiment(o, &series, &figs)?;

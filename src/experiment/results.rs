@@ -68,6 +68,24 @@ pub struct Row {
     /// pixels (empty in rows written before it was recorded).
     #[serde(default)]
     pub top_share: Option<f64>,
+    /// The metrics `[metrics] report` chooses (empty when not chosen): relMSE without its
+    /// largest 0.1 % of terms (epsilon `relmse_eps`), ...
+    #[serde(default)]
+    pub trimmed_relmse: Option<f64>,
+    /// ... MAPE and SMAPE (epsilon `mape_eps`; SMAPE without a factor 2), ...
+    #[serde(default)]
+    pub mape: Option<f64>,
+    #[serde(default)]
+    pub smape: Option<f64>,
+    #[serde(default)]
+    pub mape_eps: Option<f64>,
+    /// ... 1 - SSIM and mean FLIP of the images tone-mapped at `exposure` (clamped, sRGB).
+    #[serde(default)]
+    pub ssim_error: Option<f64>,
+    #[serde(default)]
+    pub flip: Option<f64>,
+    #[serde(default)]
+    pub exposure: Option<f64>,
 }
 
 impl Row {
@@ -149,6 +167,81 @@ impl Results {
     }
 }
 
+/// One value of `metrics.csv`: a run's error in one metric, named with what defines it.
+#[derive(Serialize)]
+struct MetricRow<'a> {
+    case: &'a str,
+    strategy: &'a str,
+    name: &'a str,
+    kind: &'a str,
+    budget_s: f64,
+    spp: u32,
+    seed: u64,
+    metric: &'static str,
+    /// Empty where the metric has none.
+    epsilon: Option<f64>,
+    /// "linear" or the display transform SSIM and FLIP compare.
+    tone_mapping: String,
+    /// MSE and relMSE as measured (not corrected for the reference's noise; results.csv has
+    /// both).
+    value: f64,
+}
+
+/// `metrics.csv`: every run's every measured metric, one per row, each row naming the
+/// metric, its epsilon and its tone mapping.
+pub fn write_long(path: &Path, rows: &[Row]) -> Result<(), String> {
+    use super::schema::ErrorMetric as M;
+    write_atomic(path, |tmp| {
+        let mut w = csv::Writer::from_path(tmp).map_err(|e| e.to_string())?;
+        for r in rows {
+            let tm = |e: Option<f64>| match e {
+                Some(x) => format!("exposure {x}; clamp to [0 1]; sRGB"),
+                None => String::new(),
+            };
+            let values = [
+                (M::Mse, Some(r.mse), None, String::from("linear")),
+                (
+                    M::Relmse,
+                    Some(r.relmse),
+                    Some(r.relmse_eps),
+                    "linear".into(),
+                ),
+                (
+                    M::TrimmedRelmse,
+                    r.trimmed_relmse,
+                    Some(r.relmse_eps),
+                    "linear".into(),
+                ),
+                (M::Mape, r.mape, r.mape_eps, "linear".into()),
+                (M::Smape, r.smape, r.mape_eps, "linear".into()),
+                (M::Ssim, r.ssim_error, None, tm(r.exposure)),
+                (M::Flip, r.flip, None, tm(r.exposure)),
+            ];
+            for (m, v, epsilon, tone_mapping) in values {
+                let Some(value) = v else { continue };
+                w.serialize(MetricRow {
+                    case: &r.case,
+                    strategy: &r.strategy,
+                    name: &r.name,
+                    kind: &r.kind,
+                    budget_s: r.budget_s,
+                    spp: r.spp,
+                    seed: r.seed,
+                    metric: match m {
+                        M::Ssim => "1-ssim",
+                        _ => m.slug(),
+                    },
+                    epsilon,
+                    tone_mapping,
+                    value,
+                })
+                .map_err(|e| e.to_string())?;
+            }
+        }
+        w.flush().map_err(|e| e.to_string())
+    })
+}
+
 #[cfg(test)]
 pub(crate) fn test_row(strategy: &str, spp: u32, seed: u64) -> Row {
     Row {
@@ -183,6 +276,13 @@ pub(crate) fn test_row(strategy: &str, spp: u32, seed: u64) -> Row {
         z: None,
         max_sample: None,
         top_share: None,
+        trimmed_relmse: None,
+        mape: None,
+        smape: None,
+        mape_eps: None,
+        ssim_error: None,
+        flip: None,
+        exposure: None,
     }
 }
 

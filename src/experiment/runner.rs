@@ -3,7 +3,7 @@
 
 use super::cache::{self, Fnv, KeyInputs, Reference, ReferenceRequest};
 use super::leftout::{leave_out, Omission, SceneTraits};
-use super::measure::measure;
+use super::measure::{measure, Extra};
 use super::method::{cross, Method};
 use super::plan::{
     has_image, image_path, plan_sweep, rate, same_run, time_tag, variance_path, Job, Sweep,
@@ -52,6 +52,7 @@ pub(crate) struct Ctx<'a> {
     pub(crate) scene: &'a Scene,
     pub(crate) reference: &'a Reference,
     pub(crate) eps: f64,
+    pub(crate) extra: &'a Extra,
     pub(crate) context: String,
     pub(crate) threads: Option<usize>,
 }
@@ -82,7 +83,7 @@ pub(crate) fn render_job(ctx: &Ctx, job: &Job) -> Result<(Row, RenderOutput), St
         .map_err(|e| format!("{} at {} spp: {e}", job.method.label(), job.spp))?;
     let out = render(ctx.scene, job.method.strategy, &settings);
     Ok((
-        measure(ctx.reference, ctx.eps, &ctx.context, job, &out),
+        measure(ctx.reference, ctx.eps, ctx.extra, &ctx.context, job, &out),
         out,
     ))
 }
@@ -236,10 +237,13 @@ pub(crate) struct Setup {
     pub(crate) kept: Named,
     pub(crate) omitted: Vec<Omission>,
     pub(crate) eps: f64,
+    /// The metrics measured beside MSE and relMSE.
+    pub(crate) extra: Extra,
     pub(crate) source: RefSource,
     /// The reference's cache key.
     pub(crate) key: String,
-    /// Rows measured against this reference and epsilon carry it (`Row::context`).
+    /// Rows measured against this reference, epsilon and metric choice carry it
+    /// (`Row::context`).
     pub(crate) context: String,
 }
 
@@ -337,10 +341,14 @@ pub(crate) fn setup(exp: Resolved, opts: &RunOptions) -> Result<Setup, String> {
         }
         (None, None) => unreachable!("validated: a reference is rendered or given"),
     };
+    let extra = Extra::of(x);
     let mut h = Fnv::new();
     h.field(key.as_bytes()).field(&eps.to_le_bytes());
+    // Rows measured before with other metrics are redone, not left without them.
+    h.field(extra.key().as_bytes());
     Ok(Setup {
         context: h.hex(),
+        extra,
         exp,
         dir,
         scene,
@@ -393,6 +401,7 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
         scene: &s.scene,
         reference: &reference,
         eps: s.eps,
+        extra: &s.extra,
         context: s.context.clone(),
         threads: opts.threads,
     };

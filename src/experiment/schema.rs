@@ -141,11 +141,53 @@ impl Default for ReferenceSpec {
     }
 }
 
+/// An error of a render against the reference. MSE and relMSE are corrected for the
+/// reference's noise and have predicted values (they can be `primary`); the others are
+/// reported beside them (`report`), raw.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "lowercase")]
+#[serde(rename_all = "kebab-case")]
 pub enum ErrorMetric {
     Mse,
     Relmse,
+    /// relMSE without its largest 0.1 % of terms.
+    TrimmedRelmse,
+    /// mean |x - r| / (|r| + eps).
+    Mape,
+    /// mean |x - r| / (|x| + |r| + eps), without a factor 2.
+    Smape,
+    /// 1 - SSIM on tone-mapped sRGB.
+    Ssim,
+    /// Mean FLIP on tone-mapped 8-bit sRGB.
+    Flip,
+}
+
+impl ErrorMetric {
+    /// Every metric beside MSE and relMSE, the default of `report`.
+    pub const EXTRA: [ErrorMetric; 5] = [
+        ErrorMetric::TrimmedRelmse,
+        ErrorMetric::Mape,
+        ErrorMetric::Smape,
+        ErrorMetric::Ssim,
+        ErrorMetric::Flip,
+    ];
+
+    /// Its name in experiment files and file names.
+    pub fn slug(self) -> &'static str {
+        match self {
+            ErrorMetric::Mse => "mse",
+            ErrorMetric::Relmse => "relmse",
+            ErrorMetric::TrimmedRelmse => "trimmed-relmse",
+            ErrorMetric::Mape => "mape",
+            ErrorMetric::Smape => "smape",
+            ErrorMetric::Ssim => "ssim",
+            ErrorMetric::Flip => "flip",
+        }
+    }
+
+    /// Whether it is measured on tone-mapped images (then the exposure is part of it).
+    pub fn tone_mapped(self) -> bool {
+        matches!(self, ErrorMetric::Ssim | ErrorMetric::Flip)
+    }
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -154,9 +196,20 @@ pub struct MetricsSpec {
     /// relMSE = mean((x - r)^2 / (r^2 + epsilon)).
     #[serde(default = "default_eps")]
     pub relmse_epsilon: f64,
-    /// The error the plots and tables use.
+    /// The error the plots and tables use: "mse" or "relmse".
     #[serde(default = "default_metric")]
     pub primary: ErrorMetric,
+    /// Metrics reported beside MSE and relMSE (CSV columns, metrics.csv, a convergence plot
+    /// each): "trimmed-relmse", "mape", "smape", "ssim" (as 1 - SSIM), "flip".
+    #[serde(default = "default_report")]
+    pub report: Vec<ErrorMetric>,
+    /// epsilon of MAPE and SMAPE.
+    #[serde(default = "default_eps")]
+    pub mape_epsilon: f64,
+}
+
+fn default_report() -> Vec<ErrorMetric> {
+    ErrorMetric::EXTRA.to_vec()
 }
 
 fn default_eps() -> f64 {
@@ -172,6 +225,8 @@ impl Default for MetricsSpec {
         MetricsSpec {
             relmse_epsilon: default_eps(),
             primary: default_metric(),
+            report: default_report(),
+            mape_epsilon: default_eps(),
         }
     }
 }

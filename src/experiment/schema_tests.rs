@@ -255,3 +255,35 @@ fn image_sweeps_take_one_scene_and_a_rendered_or_constant_reference() {
     let e = resolve(parse(&eps0, &file()).unwrap(), &file(), false).unwrap_err();
     assert!(e.contains("relmse_epsilon must be positive"), "{e}");
 }
+
+#[test]
+fn metrics_report_defaults_to_every_extra_and_checks_its_choices() {
+    let r = resolve(parse(EXAMPLE, &file()).unwrap(), &file(), false).unwrap();
+    assert_eq!(r.exp.metrics.report, ErrorMetric::EXTRA.to_vec());
+    assert_eq!(r.exp.metrics.mape_epsilon, 0.01);
+    let some = EXAMPLE.replace(
+        "relmse_epsilon = 0.001",
+        "relmse_epsilon = 0.001\nreport = [\"ssim\", \"flip\"]\nmape_epsilon = 0.1",
+    );
+    let r = resolve(parse(&some, &file()).unwrap(), &file(), false).unwrap();
+    assert_eq!(r.exp.metrics.report, [ErrorMetric::Ssim, ErrorMetric::Flip]);
+    assert_eq!(r.exp.metrics.mape_epsilon, 0.1);
+    let err = |from: &str, to: &str| {
+        let text = EXAMPLE.replace(from, to);
+        match parse(&text, &file()) {
+            Ok(e) => resolve(e, &file(), false).unwrap_err(),
+            Err(e) => e,
+        }
+    };
+    let e = err("relmse_epsilon = 0.001", "primary = \"ssim\"");
+    assert!(
+        e.contains("metrics.primary = \"ssim\"") && e.contains("metrics.report"),
+        "{e}"
+    );
+    let e = err("relmse_epsilon = 0.001", "report = [\"relmse\"]");
+    assert!(e.contains("always reported"), "{e}");
+    let e = err("relmse_epsilon = 0.001", "report = [\"psnr\"]");
+    assert!(e.contains("psnr") && e.contains("trimmed-relmse"), "{e}");
+    let e = err("relmse_epsilon = 0.001", "mape_epsilon = 0");
+    assert!(e.contains("mape_epsilon = 0"), "{e}");
+}

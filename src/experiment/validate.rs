@@ -2,6 +2,7 @@
 //! and the expansion of its `scene` or `[[case]]`s into runnable cases.
 
 use super::cases::{merge_defines, Case, CaseReferenceSpec, CaseSpec, MIN_BATCHES};
+use super::schema::ErrorMetric;
 use super::schema::Experiment;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -95,6 +96,33 @@ pub(crate) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
     let eps = exp.metrics.relmse_epsilon;
     if !(eps > 0.0 || (eps == 0.0 && exp.probe.is_some())) {
         return fail("metrics.relmse_epsilon must be positive (0 is allowed in probe mode)".into());
+    }
+    let m = &exp.metrics;
+    if !matches!(m.primary, ErrorMetric::Mse | ErrorMetric::Relmse) {
+        return fail(format!(
+            "metrics.primary = \"{}\": expected \"mse\" or \"relmse\" (the errors corrected for the \
+             reference's noise); list \"{0}\" in metrics.report to have it reported beside them",
+            m.primary.slug()
+        ));
+    }
+    if !(m.mape_epsilon > 0.0 && m.mape_epsilon.is_finite()) {
+        return fail(format!(
+            "metrics.mape_epsilon = {}: expected a positive number",
+            m.mape_epsilon
+        ));
+    }
+    if let Some(x) = m
+        .report
+        .iter()
+        .find(|x| matches!(x, ErrorMetric::Mse | ErrorMetric::Relmse))
+    {
+        return fail(format!(
+            "metrics.report lists \"{}\", which is always reported; list only {}",
+            x.slug(),
+            ErrorMetric::EXTRA
+                .map(|e| format!("\"{}\"", e.slug()))
+                .join(", ")
+        ));
     }
     let mut names: Vec<&str> = exp.strategies.iter().map(|s| s.name.as_str()).collect();
     names.sort();

@@ -149,6 +149,7 @@ pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> R
     left_out(&mut md, o);
     tables::error_table(&mut md, o, series);
     tables::rate_table(&mut md, o, series);
+    tables::metrics_table(&mut md, o);
     tables::diagnostics(&mut md, o, series);
     tables::equal_time_table(&mut md, o);
     means::means(&mut md, o);

@@ -2,7 +2,9 @@
 //! variance.
 
 use super::e;
-use crate::experiment::analysis::{error_of, metric_name, predicted_of, Series};
+use crate::experiment::analysis::{
+    error_of, metric_label, metric_name, metric_short, predicted_of, Series,
+};
 use crate::experiment::results::{Row, EQUAL_TIME};
 use crate::experiment::runner::Outcome;
 use crate::experiment::schema::ErrorMetric;
@@ -48,6 +50,61 @@ pub(super) fn error_table(md: &mut String, o: &Outcome, series: &[Series]) {
             });
         let _ = writeln!(line, " {:.2e} |", if t > 0.0 { n / t } else { 0.0 });
         md.push_str(&line);
+    }
+    md.push('\n');
+}
+
+/// The metrics beside the primary one at the figures' comparison spp, mean over seeds: one
+/// column each, named with its epsilon and tone mapping in the caption.
+pub(super) fn metrics_table(md: &mut String, o: &Outcome) {
+    let x = &o.exp.exp;
+    let spp = o.exp.equal_spp();
+    let mut metrics = vec![ErrorMetric::Mse, ErrorMetric::Relmse];
+    metrics.extend(x.metrics.report.iter().copied());
+    let (eps, meps, exposure) = (
+        x.metrics.relmse_epsilon,
+        x.metrics.mape_epsilon,
+        x.figures.exposure.unwrap_or(1.0),
+    );
+    let _ = writeln!(
+        md,
+        "## Metrics at {spp} spp
+
+Mean over seeds, raw (not corrected for the reference noise); \
+         every value per run and metric is in `metrics.csv`. {}.\n",
+        metrics
+            .iter()
+            .map(|&m| metric_label(m, eps, meps, exposure))
+            .collect::<Vec<_>>()
+            .join("; ")
+    );
+    let mut head = "| strategy |".to_string();
+    let mut rule = "|---|".to_string();
+    for m in &metrics {
+        let _ = write!(head, " {} |", metric_short(*m));
+        rule.push_str("---|");
+    }
+    let _ = writeln!(md, "{head}\n{rule}");
+    for (label, name) in &o.strategies {
+        let rows: Vec<&Row> = o
+            .rows
+            .iter()
+            .filter(|r| r.is_sweep() && &r.strategy == label && r.spp == spp)
+            .collect();
+        if rows.is_empty() {
+            continue;
+        }
+        let mut line = format!("| {name} |");
+        for &m in &metrics {
+            let raw = |r: &Row| match m {
+                ErrorMetric::Mse => r.mse,
+                ErrorMetric::Relmse => r.relmse,
+                _ => error_of(r, m),
+            };
+            let mean = rows.iter().map(|r| raw(r)).sum::<f64>() / rows.len() as f64;
+            let _ = write!(line, " {} |", e(mean));
+        }
+        let _ = writeln!(md, "{line}");
     }
     md.push('\n');
 }

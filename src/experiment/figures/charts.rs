@@ -1,7 +1,7 @@
 //! Convergence charts: error against spp and against time, and efficiency.
 
 use super::Figure;
-use crate::experiment::analysis::{metric_name, series, Point, Series};
+use crate::experiment::analysis::{metric_label, metric_name, metric_short, series, Point, Series};
 use crate::experiment::runner::Outcome;
 use crate::experiment::schema::ErrorMetric;
 use crate::plot::{write_chart, Line, LogLogChart};
@@ -13,7 +13,7 @@ pub fn charts(o: &Outcome) -> Result<(Vec<Series>, Vec<Figure>), String> {
     let ss = series(&o.rows, &o.strategies, m);
     let floor = match m {
         ErrorMetric::Mse => o.reference.info.mse_floor,
-        ErrorMetric::Relmse => o.reference.info.relmse_floor,
+        _ => o.reference.info.relmse_floor,
     };
     let line = |s: &Series, f: &dyn Fn(&Point) -> (f64, f64)| Line {
         label: match s.slope {
@@ -92,5 +92,35 @@ pub fn charts(o: &Outcome) -> Result<(Vec<Series>, Vec<Figure>), String> {
          whose cost grows linearly with spp."
             .into(),
     )?;
+    let x = &o.exp.exp;
+    for &m in &x.metrics.report {
+        let what = metric_label(
+            m,
+            x.metrics.relmse_epsilon,
+            x.metrics.mape_epsilon,
+            x.figures.exposure.unwrap_or(1.0),
+        );
+        let ms = series(&o.rows, &o.strategies, m);
+        if ms.iter().all(|s| s.points.iter().all(|p| !(p.error > 0.0))) {
+            continue;
+        }
+        chart(
+            &format!("convergence-{}", m.slug()),
+            LogLogChart {
+                title: format!("{} vs samples per pixel", metric_short(m)),
+                x_label: "samples per pixel".into(),
+                y_label: what.clone(),
+                lines: ms
+                    .iter()
+                    .map(|s| line(s, &|p| (p.spp as f64, p.error)))
+                    .collect(),
+                hline: None,
+            },
+            format!(
+                "{what} against spp, mean over the seeds (raw: not corrected for the \
+                 reference's noise); slopes fitted as above."
+            ),
+        )?;
+    }
     Ok((ss, figs))
 }

@@ -70,6 +70,13 @@ pub(crate) fn rows(
                 z: Some(st.z),
                 max_sample: Some(st.max_sample),
                 top_share: Some(st.top_share),
+                trimmed_relmse: None,
+                mape: None,
+                smape: None,
+                mape_eps: None,
+                ssim_error: None,
+                flip: None,
+                exposure: None,
             }
         })
         .collect()

@@ -130,6 +130,7 @@ pub fn run_shard(
                         scene: &p.s.scene,
                         reference: &reference,
                         eps: p.s.eps,
+                        extra: &p.s.extra,
                         context: p.s.context.clone(),
                         threads,
                     };
