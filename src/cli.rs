@@ -81,12 +81,8 @@ pub struct ReproduceArgs {
 }
 
 fn run_files(files: &[PathBuf], a: &SweepArgs) -> Result<(), String> {
-    use crate::experiment::{run_and_report, RunOptions};
-    let opts = RunOptions {
-        out: a.out.clone(),
-        threads: a.threads,
-        fresh_reference: a.fresh_reference,
-    };
+    use crate::experiment::{events, run_and_report};
+    let opts = crate::experiment::args::options(a);
     let start = std::time::Instant::now();
     let mut failed = Vec::new();
     for f in files {
@@ -99,10 +95,23 @@ fn run_files(files: &[PathBuf], a: &SweepArgs) -> Result<(), String> {
             } else {
                 eprintln!("error: {shown}: {e}");
             }
+            events::emit(
+                "experiment_failed",
+                serde_json::json!({ "file": f, "error": e }),
+            );
             failed.push(f.display().to_string());
         }
     }
     crate::report::write_root_index(&a.out)?;
+    events::emit(
+        "finished",
+        serde_json::json!({
+            "experiments": files.len(),
+            "failed": failed,
+            "seconds": start.elapsed().as_secs_f64(),
+            "index": a.out.join("index.md"),
+        }),
+    );
     eprintln!(
         "{} experiment(s) in {:.1} s; reports in {}",
         files.len(),

@@ -483,3 +483,59 @@ fn quick_fig5_runs_every_emitter_choice() {
     assert!(tree * 10.0 < power, "tree {tree} vs power {power}");
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// `--json`: stdout is one JSON object per line, events in order, one result per row;
+/// results.jsonl holds the rows; progress without a terminal is plain lines counted in
+/// samples.
+#[test]
+fn json_events_and_results_jsonl() {
+    let out = scratch("json");
+    let o = run(directlab()
+        .args(["run", repo("experiments/fig2.toml").to_str().unwrap()])
+        .args(["--quick", "--json", "--out"])
+        .arg(&out));
+    assert!(o.status.success());
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let events: Vec<serde_json::Value> = stdout
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("not JSON: {l}: {e}")))
+        .collect();
+    let kinds: Vec<&str> = events
+        .iter()
+        .map(|e| e["event"].as_str().unwrap())
+        .collect();
+    let results = kinds.iter().filter(|k| **k == "result").count();
+    assert_eq!(results, 2 * 3 * 2 + 2, "{kinds:?}");
+    let order: Vec<&str> = kinds.iter().copied().filter(|k| *k != "result").collect();
+    assert_eq!(
+        order,
+        [
+            "experiment_started",
+            "reference",
+            "sweep_started",
+            "report_written",
+            "finished"
+        ]
+    );
+    let row = &events.iter().find(|e| e["event"] == "result").unwrap()["row"];
+    assert_eq!(row["relmse_eps"], 0.01);
+    assert!(row["flip"].as_f64().is_some(), "{row}");
+    // A 1 spp row has no z^2 (NaN): null in JSON.
+    assert!(events
+        .iter()
+        .any(|e| e["event"] == "result" && e["row"]["spp"] == 1 && e["row"]["mean_z2"].is_null()));
+    let report = events
+        .iter()
+        .find(|e| e["event"] == "report_written")
+        .unwrap();
+    let jsonl = std::fs::read_to_string(report["results_jsonl"].as_str().unwrap()).unwrap();
+    assert_eq!(jsonl.lines().count(), results);
+    for l in jsonl.lines() {
+        let r: serde_json::Value = serde_json::from_str(l).unwrap();
+        assert!(r["strategy"].is_string());
+    }
+    // The human lines went to stderr, with a final progress line in samples.
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("rendered now"), "{stderr}");
+    assert!(stderr.contains("14/14 runs, 100 % of samples"), "{stderr}");
+}

@@ -21,10 +21,16 @@ pub struct SweepArgs {
     /// dependency; changes to the renderer's own source are detected).
     #[arg(long)]
     pub fresh_reference: bool,
+    /// Print one JSON object per event on stdout (run started, reference, result row, unit
+    /// done, report written, finished); the other output goes to stderr.
+    #[arg(long)]
+    pub json: bool,
 }
 
-/// The runner's options from the command line's.
+/// The runner's options from the command line's (and `--json` switched on for the
+/// process).
 pub fn options(a: &SweepArgs) -> RunOptions {
+    super::events::set_json(a.json);
     RunOptions {
         out: a.out.clone(),
         threads: a.threads,

@@ -6,6 +6,7 @@ pub mod args;
 pub mod cache;
 pub mod cases;
 pub mod chunks;
+pub mod events;
 pub mod figures;
 pub mod leftout;
 mod measure;
@@ -37,19 +38,34 @@ pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(),
 /// Writes the figures and report of a finished sweep and prints its summary.
 pub fn report_outcome(o: &Outcome) -> Result<(), String> {
     results::write_long(&o.dir.join("metrics.csv"), &o.rows)?;
+    events::write_jsonl(&o.dir.join("results.jsonl"), &o.rows)?;
     let (series, mut figs) = figures::charts(o)?;
     figs.extend(figures::images(o)?);
     crate::report::write_experiment(o, &series, &figs)?;
     for l in crate::report::mean_check_lines(o) {
-        println!("{}: {l}", o.exp.name);
+        events::say(&format!("{}: {l}", o.exp.name));
     }
-    println!(
+    let index = o.dir.join("index.md");
+    events::say(&format!(
         "{}: {} runs ({} rendered now) in {:.1} s -> {}",
         o.exp.name,
         o.rows.len(),
         o.rendered,
         o.seconds,
-        o.dir.join("index.md").display()
+        index.display()
+    ));
+    events::emit(
+        "report_written",
+        serde_json::json!({
+            "experiment": o.exp.name,
+            "index": index,
+            "results_csv": o.dir.join("results.csv"),
+            "results_jsonl": o.dir.join("results.jsonl"),
+            "metrics_csv": o.dir.join("metrics.csv"),
+            "runs": o.rows.len(),
+            "rendered": o.rendered,
+            "seconds": o.seconds,
+        }),
     );
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! seed) sweep and the equal-time runs, resuming from `results.csv`; then figures and report.
 
 use super::cache::{self, Fnv, KeyInputs, Reference, ReferenceRequest};
+use super::events::{self, Progress};
 use super::leftout::{leave_out, Omission, SceneTraits};
 use super::measure::{measure, Extra};
 use super::method::{cross, Method};
@@ -14,7 +15,7 @@ use crate::film;
 use crate::integrator::Strategy;
 use crate::render::{render, RenderOutput, RenderSettings};
 use crate::scene::Scene;
-use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::json;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -88,22 +89,6 @@ pub(crate) fn render_job(ctx: &Ctx, job: &Job) -> Result<(Row, RenderOutput), St
     ))
 }
 
-fn progress_bar(total_samples: u64, runs: usize) -> ProgressBar {
-    if !std::io::stderr().is_terminal() || runs == 0 {
-        return ProgressBar::hidden();
-    }
-    let b = ProgressBar::new(total_samples);
-    b.set_style(
-        ProgressStyle::with_template(
-            "{spinner} {msg} [{bar:30}] {percent}%, {elapsed} (eta {eta})",
-        )
-        .expect("static template")
-        .progress_chars("=> "),
-    );
-    b.set_message(format!("0/{runs} runs"));
-    b
-}
-
 /// The cached reference, or a new render; prints where it came from and its noise floor.
 fn rendered_reference(
     s: &Setup,
@@ -133,6 +118,18 @@ fn rendered_reference(
 /// Says where the reference came from and its noise floor.
 pub(crate) fn print_reference(name: &str, reference: &Reference) {
     let ri = &reference.info;
+    events::emit(
+        "reference",
+        json!({
+            "experiment": name,
+            "strategy": ri.strategy,
+            "spp": ri.spp,
+            "cached": reference.cached,
+            "seconds": ri.seconds,
+            "mse_floor": ri.mse_floor,
+            "relmse_floor": ri.relmse_floor,
+        }),
+    );
     eprintln!(
         "{name}: reference {} at {} spp ({}, {:.1} s to render); noise floor MSE {:.3e}, relMSE {:.3e}",
         ri.strategy,
@@ -395,6 +392,10 @@ pub(crate) fn equal_time_spp(
 pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, String> {
     let start = Instant::now();
     let s = setup(exp, opts)?;
+    events::emit(
+        "experiment_started",
+        json!({ "experiment": s.exp.name, "file": s.exp.file, "dir": s.dir }),
+    );
     let reference = s.reference(opts)?;
     let (exp, dir, x) = (&s.exp, &s.dir, &s.exp.exp);
     let ctx = Ctx {
@@ -422,36 +423,35 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
         .as_ref()
         .map_or(0, |e| e.seconds.len() * e.seeds as usize * kept.len());
     let runs = jobs.len() + equal_time_runs;
-    // The bar counts camera samples; equal-time runs are added once their spp is known.
-    let bar = progress_bar(jobs.iter().map(|j| j.spp as u64 * pixels).sum(), runs);
+    // Counted in camera samples; equal-time runs are added once their spp is known.
+    let samples: u64 = jobs.iter().map(|j| j.spp as u64 * pixels).sum();
+    events::emit(
+        "sweep_started",
+        json!({ "experiment": exp.name, "runs": runs, "samples": samples }),
+    );
+    let mut bar = Progress::new(&exp.name, samples, runs);
     let mut rendered = 0;
-    let mut run = |job: &Job, results: &mut Results| -> Result<(), String> {
+    let mut run = |job: &Job, results: &mut Results, bar: &mut Progress| -> Result<(), String> {
         let row = execute(&ctx, job)?;
         results.rows.retain(|r| !same_run(r, &row));
-        bar.inc(job.spp as u64 * pixels);
+        bar.run_done(job.spp as u64 * pixels);
         rendered += 1;
-        if bar.is_hidden() {
-            eprintln!(
-                "{}: {} {} spp seed {}: relMSE {:.3e} in {:.2} s",
-                exp.name, row.strategy, row.spp, row.seed, row.relmse, row.seconds
-            );
-        }
-        bar.set_message(format!("{rendered}/{runs} runs"));
+        events::result(&exp.name, &row);
         results.push_and_save(row, &csv)
     };
     for job in &jobs {
-        run(job, &mut results)?;
+        run(job, &mut results, &mut bar)?;
     }
 
     let timed = match &x.equal_time {
         Some(et) => equal_time_jobs(et, kept, &results, dir, pixels)?,
         None => Vec::new(),
     };
-    bar.inc_length(timed.iter().map(|j| j.spp as u64 * pixels).sum());
+    bar.add(timed.iter().map(|j| j.spp as u64 * pixels).sum());
     for job in &timed {
-        run(job, &mut results)?;
+        run(job, &mut results, &mut bar)?;
     }
-    bar.finish_and_clear();
+    bar.finish();
     let near = results.rows.iter().filter(|r| r.near_floor).count();
     if near > 0 {
         eprintln!(

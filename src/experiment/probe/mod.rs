@@ -23,10 +23,22 @@ pub fn run_and_report(exp: super::Resolved, opts: &RunOptions) -> Result<(), Str
     let o = run_probe(exp, opts)?;
     let figure = figure::write(&o)?;
     crate::report::probe::write(&o, figure.as_deref())?;
+    super::events::write_jsonl(&o.dir.join("results.jsonl"), &o.rows)?;
+    super::events::emit(
+        "report_written",
+        serde_json::json!({
+            "experiment": o.exp.name,
+            "index": o.dir.join("index.md"),
+            "results_csv": o.dir.join("results.csv"),
+            "results_jsonl": o.dir.join("results.jsonl"),
+            "runs": o.rows.len(),
+            "seconds": o.seconds,
+        }),
+    );
     let table = crate::report::probe::table(&o);
     let count = |v: &str| table.iter().filter(|r| r.verdict == v).count();
     let failed_checks = o.checks.iter().filter(|c| !c.ok).count();
-    println!(
+    super::events::say(&format!(
         "{}: {} streams ({} drawn now), {} non-finite samples; {} ok, {} tail unsampled, {} biased; {} of {} input checks failed; {:.1} s -> {}",
         o.exp.name,
         o.streams,
@@ -39,7 +51,7 @@ pub fn run_and_report(exp: super::Resolved, opts: &RunOptions) -> Result<(), Str
         o.checks.len(),
         o.seconds,
         o.dir.join("index.md").display()
-    );
+    ));
     Ok(())
 }
 

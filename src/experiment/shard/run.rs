@@ -148,6 +148,16 @@ pub fn run_shard(
             match r {
                 Ok(()) => {
                     ran += 1;
+                    crate::experiment::events::emit(
+                        "unit_done",
+                        serde_json::json!({
+                            "experiment": name,
+                            "shard": format!("{}/{}", shard.index, shard.count),
+                            "unit": i,
+                            "name": p.plan.units[i].name,
+                            "seconds": t.elapsed().as_secs_f64(),
+                        }),
+                    );
                     eprintln!(
                         "{name}: shard {}/{}: {} done in {:.2} s",
                         shard.index,
