@@ -1,6 +1,7 @@
 //! Markdown reports: `reports/<experiment>/index.md` (settings, reference and its noise,
 //! what was left out and why, tables, figures) and `reports/index.md` linking them all.
 
+pub mod html;
 mod means;
 pub mod probe;
 mod probe_table;
