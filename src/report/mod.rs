@@ -166,7 +166,8 @@ pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> R
     let path = o.dir.join("index.md");
     write_atomic(&path, |tmp| {
         std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display()))
-    })
+    })?;
+    html::page::write(o)
 }
 
 /// Writes `<root>/index.md` linking every report under `root`: each folder's `index.md`
@@ -203,7 +204,8 @@ pub fn write_root_index(root: &Path) -> Result<(), String> {
     let path = root.join("index.md");
     write_atomic(&path, |tmp| {
         std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display()))
-    })
+    })?;
+    html::page::write_root(root, &entries)
 }
 
 #[cfg(test)]
@@ -222,6 +224,18 @@ mod tests {
         let md = std::fs::read_to_string(dir.join("index.md")).unwrap();
         assert!(md.contains("- [Figure 1](fig1/index.md)"), "{md}");
         assert!(md.contains("- [Bug gallery](gallery.md)"), "{md}");
+        // The HTML index links the interactive page where there is one, else the Markdown.
+        std::fs::write(dir.join("fig1/index.html"), "<html></html>").unwrap();
+        write_root_index(&dir).unwrap();
+        let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+        assert!(
+            html.contains("<a href=\"fig1/index.html\">Figure 1</a>"),
+            "{html}"
+        );
+        assert!(
+            html.contains("<a href=\"gallery.md\">Bug gallery</a>"),
+            "{html}"
+        );
         assert!(!md.contains("empty"), "{md}");
         write_root_index(&dir).unwrap();
         let again = std::fs::read_to_string(dir.join("index.md")).unwrap();

@@ -2,3 +2,4 @@
 //! ([`data`]); the page and its browser test come next.
 
 pub mod data;
+pub mod page;

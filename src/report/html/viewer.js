@@ -1,0 +1,125 @@
+// directlab's report viewer: a classic script (pages open from disk: no modules, no fetch).
+// DL (set by the page) holds the images as zlib-compressed RGBE in base64.
+"use strict";
+(function () {
+  const $ = (id) => document.getElementById(id);
+  const W = DL.width, H = DL.height;
+  const imgs = [];      // Float32Array RGB per image, in DL.images order
+  let cur = 1, holdRef = false, view = "image";
+
+  async function inflate(b64) {
+    const bin = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+    const s = new Blob([bin]).stream().pipeThrough(new DecompressionStream("deflate"));
+    return new Uint8Array(await new Response(s).arrayBuffer());
+  }
+  function fromRgbe(b) {
+    const f = new Float32Array((b.length / 4) * 3);
+    for (let i = 0, j = 0; i < b.length; i += 4, j += 3) {
+      if (b[i + 3] === 0) continue;
+      const s = Math.pow(2, b[i + 3] - 136);
+      f[j] = (b[i] + 0.5) * s; f[j + 1] = (b[i + 1] + 0.5) * s; f[j + 2] = (b[i + 2] + 0.5) * s;
+    }
+    return f;
+  }
+  const srgb = (v) => (v <= 0.0031308 ? 12.92 * v : 1.055 * Math.pow(v, 1 / 2.4) - 0.055);
+  function exposure() { return Math.pow(2, parseFloat($("ev").value)) * DL.exposure; }
+  // False colour for t in [0, 1]: dark blue, cyan, yellow, red.
+  function ramp(t) {
+    t = Math.min(1, Math.max(0, t));
+    const k = [[0.05, 0.05, 0.35], [0.0, 0.7, 0.9], [1.0, 0.9, 0.1], [0.85, 0.05, 0.05]];
+    const x = t * 3, i = Math.min(2, Math.floor(x)), u = x - i;
+    return k[i].map((a, c) => 255 * (a + (k[i + 1][c] - a) * u));
+  }
+  function pixel(view, x, r, i) {
+    if (view === "image") {
+      const e = exposure();
+      return [0, 1, 2].map((c) => 255 * srgb(Math.min(1, Math.max(0, x[i + c] * e))));
+    }
+    if (view === "relmse") {
+      let s = 0;
+      for (let c = 0; c < 3; c++) s += (x[i + c] - r[i + c]) ** 2 / (r[i + c] ** 2 + DL.eps);
+      // log10 of the pixel's relMSE over the scene's fixed decades.
+      const t = (Math.log10(s / 3 + 1e-30) - DL.relmse_lo) / (DL.relmse_hi - DL.relmse_lo);
+      return ramp(t);
+    }
+    let d = 0, m = 0;
+    for (let c = 0; c < 3; c++) { d += x[i + c] - r[i + c]; m += r[i + c]; }
+    const t = 0.5 + 0.5 * Math.max(-1, Math.min(1, d / (m + DL.eps * 3) / DL.signed_range));
+    return t < 0.5 ? [255 * 2 * t, 255 * 2 * t, 255] : [255, 255 * 2 * (1 - t), 255 * 2 * (1 - t)];
+  }
+  function draw() {
+    const show = holdRef ? 0 : cur;
+    const x = imgs[show], r = imgs[0];
+    const ctx = $("canvas").getContext("2d");
+    const out = ctx.createImageData(W, H);
+    const v = show === 0 && view !== "image" ? "image" : view;
+    for (let p = 0; p < W * H; p++) {
+      const c = pixel(v, x, r, 3 * p);
+      out.data[4 * p] = c[0]; out.data[4 * p + 1] = c[1]; out.data[4 * p + 2] = c[2];
+      out.data[4 * p + 3] = 255;
+    }
+    ctx.putImageData(out, 0, 0);
+    document.querySelectorAll("#tabs button").forEach((b, i) => b.classList.toggle("on", i === show));
+    $("caption").textContent = DL.images[show].title + (view !== "image" ? " — " + view : "");
+    $("bar").style.display = view === "image" ? "none" : "block";
+  }
+  function select(i) { if (i >= 0 && i < imgs.length) { cur = i; draw(); } }
+  function setView(v) { view = v; draw(); }
+
+  async function selftest() {
+    const checks = [];
+    const ok = (what, cond) => checks.push([what, !!cond]);
+    const at = (p) => $("canvas").getContext("2d").getImageData(p % W, Math.floor(p / W), 1, 1).data;
+    ok("images decoded", imgs.length === DL.images.length && imgs[0].length === W * H * 3);
+    select(1);
+    ok("switching shows the second image", $("caption").textContent.startsWith(DL.images[1].title));
+    // A mid-tone pixel the page writer chose and tone-mapped itself (film::to_srgb8 of the
+    // RGBE value): the canvas must show those bytes.
+    const p = DL.check.pixel;
+    const shown = () => Array.from(at(p)).slice(0, 3);
+    const want = () => pixel("image", imgs[1], imgs[0], 3 * p).map(Math.round);
+    const a = shown();
+    ok("the canvas shows what directlab's tone mapping gives",
+       [0, 1, 2].every((c) => Math.abs(a[c] - DL.check.srgb8[c]) <= 1));
+    $("ev").value = "1"; draw();
+    const b = shown();
+    ok("one stop brighter", b[0] > a[0] && [0, 1, 2].every((c) => Math.abs(b[c] - want()[c]) <= 1));
+    $("ev").value = "0";
+    holdRef = true; draw();
+    ok("holding shows the reference", $("caption").textContent.startsWith(DL.images[0].title));
+    holdRef = false;
+    setView("relmse"); ok("relMSE map", $("bar").style.display === "block");
+    setView("signed"); ok("signed error map", $("caption").textContent.includes("signed"));
+    setView("image"); select(1);
+    const failed = checks.filter((c) => !c[1]).map((c) => c[0]);
+    $("selftest").textContent = failed.length === 0
+      ? "SELFTEST PASS " + checks.length + " checks"
+      : "SELFTEST FAIL " + failed.join("; ");
+  }
+
+  document.addEventListener("keydown", (e) => {
+    if (e.key >= "1" && e.key <= "9") select(parseInt(e.key, 10) - 1);
+    else if (e.key === "r" && !holdRef) { holdRef = true; draw(); }
+    else if (e.key === "e") setView(view === "relmse" ? "image" : "relmse");
+    else if (e.key === "s") setView(view === "signed" ? "image" : "signed");
+    else if (e.key === "?") $("help").classList.toggle("on");
+  });
+  document.addEventListener("keyup", (e) => { if (e.key === "r") { holdRef = false; draw(); } });
+
+  window.addEventListener("error", (e) => { $("selftest").textContent = "SELFTEST FAIL uncaught: " + e.message; });
+  Promise.all(DL.images.map((im) => inflate(im.data).then(fromRgbe)))
+    .then((all) => {
+      imgs.push(...all);
+      const c = $("canvas"); c.width = W; c.height = H;
+      DL.images.forEach((im, i) => {
+        const b = document.createElement("button");
+        b.textContent = (i + 1) + " " + im.title;
+        b.onclick = () => select(i);
+        $("tabs").appendChild(b);
+      });
+      $("ev").oninput = draw;
+      draw();
+      if (location.hash === "#selftest") return selftest();
+    })
+    .catch((e) => { $("selftest").textContent = "SELFTEST FAIL " + e; });
+})();
