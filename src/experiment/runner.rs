@@ -358,6 +358,15 @@ pub(crate) fn setup(exp: Resolved, opts: &RunOptions) -> Result<Setup, String> {
 }
 
 impl Outcome {
+    /// The experiment's title, or its name.
+    pub fn title(&self) -> String {
+        self.exp
+            .exp
+            .title
+            .clone()
+            .unwrap_or_else(|| self.exp.name.clone())
+    }
+
     /// The outcome of `rows` measured in `s` against `reference`.
     pub(crate) fn of(s: Setup, reference: Reference, rows: Vec<Row>, start: Instant) -> Outcome {
         Outcome {

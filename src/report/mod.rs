@@ -133,12 +133,7 @@ pub fn direct_part_note(integrator: &str) -> String {
 /// Writes `<dir>/index.md`.
 pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> Result<(), String> {
     let mut md = String::new();
-    let title = o
-        .exp
-        .exp
-        .title
-        .clone()
-        .unwrap_or_else(|| o.exp.name.clone());
+    let title = o.title();
     let _ = writeln!(md, "# {title}\n");
     if !o.exp.exp.description.is_empty() {
         let _ = writeln!(md, "{}\n", o.exp.exp.description.trim());

@@ -99,12 +99,7 @@ pub fn write(o: &Outcome) -> Result<(), String> {
         "signed_range": 1.0,
         "images": images,
     });
-    let title = o
-        .exp
-        .exp
-        .title
-        .clone()
-        .unwrap_or_else(|| o.exp.name.clone());
+    let title = o.title();
     let mut html = String::new();
     let _ = write!(
         html,
