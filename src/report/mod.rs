@@ -5,7 +5,7 @@ pub mod html;
 mod means;
 pub mod probe;
 mod probe_table;
-mod tables;
+pub(crate) mod tables;
 
 pub use means::{mean_check, mean_check_lines, Comparison, MEAN_ALPHA};
 

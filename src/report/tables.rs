@@ -59,8 +59,7 @@ pub(super) fn error_table(md: &mut String, o: &Outcome, series: &[Series]) {
 pub(super) fn metrics_table(md: &mut String, o: &Outcome) {
     let x = &o.exp.exp;
     let spp = o.exp.equal_spp();
-    let mut metrics = vec![ErrorMetric::Mse, ErrorMetric::Relmse];
-    metrics.extend(x.metrics.report.iter().copied());
+    let (metrics, table) = metric_means(o);
     let (eps, meps, exposure) = (
         x.metrics.relmse_epsilon,
         x.metrics.mape_epsilon,
@@ -68,9 +67,7 @@ pub(super) fn metrics_table(md: &mut String, o: &Outcome) {
     );
     let _ = writeln!(
         md,
-        "## Metrics at {spp} spp
-
-Mean over seeds, raw (not corrected for the reference noise); \
+        "## Metrics at {spp} spp\n\nMean over seeds, raw (not corrected for the reference noise); \
          every value per run and metric is in `metrics.csv`. {}.\n",
         metrics
             .iter()
@@ -85,6 +82,32 @@ Mean over seeds, raw (not corrected for the reference noise); \
         rule.push_str("---|");
     }
     let _ = writeln!(md, "{head}\n{rule}");
+    for (name, values) in table {
+        let mut line = format!("| {name} |");
+        for v in values {
+            let _ = write!(line, " {} |", e(v));
+        }
+        let _ = writeln!(md, "{line}");
+    }
+    md.push('\n');
+}
+
+/// The raw value of metric `m` in row `r` (MSE and relMSE as measured).
+pub(crate) fn raw_metric(r: &Row, m: ErrorMetric) -> f64 {
+    match m {
+        ErrorMetric::Mse => r.mse,
+        ErrorMetric::Relmse => r.relmse,
+        _ => error_of(r, m),
+    }
+}
+
+/// The experiment's metrics (MSE, relMSE, then `report`) and, per strategy with runs at the
+/// comparison spp, each one's mean over seeds.
+pub(crate) fn metric_means(o: &Outcome) -> (Vec<ErrorMetric>, Vec<(String, Vec<f64>)>) {
+    let spp = o.exp.equal_spp();
+    let mut metrics = vec![ErrorMetric::Mse, ErrorMetric::Relmse];
+    metrics.extend(o.exp.exp.metrics.report.iter().copied());
+    let mut table = Vec::new();
     for (label, name) in &o.strategies {
         let rows: Vec<&Row> = o
             .rows
@@ -94,19 +117,13 @@ Mean over seeds, raw (not corrected for the reference noise); \
         if rows.is_empty() {
             continue;
         }
-        let mut line = format!("| {name} |");
-        for &m in &metrics {
-            let raw = |r: &Row| match m {
-                ErrorMetric::Mse => r.mse,
-                ErrorMetric::Relmse => r.relmse,
-                _ => error_of(r, m),
-            };
-            let mean = rows.iter().map(|r| raw(r)).sum::<f64>() / rows.len() as f64;
-            let _ = write!(line, " {} |", e(mean));
-        }
-        let _ = writeln!(md, "{line}");
+        let means = metrics
+            .iter()
+            .map(|&m| rows.iter().map(|r| raw_metric(r, m)).sum::<f64>() / rows.len() as f64)
+            .collect();
+        table.push((name.clone(), means));
     }
-    md.push('\n');
+    (metrics, table)
 }
 
 /// Convergence rates: each curve's slope with its bootstrap interval over seeds, and the

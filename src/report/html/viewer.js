@@ -6,6 +6,9 @@
   const W = DL.width, H = DL.height;
   const imgs = [];      // Float32Array RGB per image, in DL.images order
   let cur = 1, holdRef = false, view = "image";
+  // Layout: one image, side by side with the reference, or a swipe between the two at
+  // column `split`. Zoom and pan apply to every canvas alike.
+  let layout = "single", split = Math.floor(W / 2), zoom = 1, panX = 0, panY = 0;
 
   async function inflate(b64) {
     const bin = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
@@ -47,24 +50,59 @@
     const t = 0.5 + 0.5 * Math.max(-1, Math.min(1, d / (m + DL.eps * 3) / DL.signed_range));
     return t < 0.5 ? [255 * 2 * t, 255 * 2 * t, 255] : [255, 255 * 2 * (1 - t), 255 * 2 * (1 - t)];
   }
-  function draw() {
-    const show = holdRef ? 0 : cur;
+  function render(canvas, show, splitAt) {
     const x = imgs[show], r = imgs[0];
-    const ctx = $("canvas").getContext("2d");
+    const ctx = canvas.getContext("2d");
     const out = ctx.createImageData(W, H);
     const v = show === 0 && view !== "image" ? "image" : view;
     for (let p = 0; p < W * H; p++) {
-      const c = pixel(v, x, r, 3 * p);
+      // In a swipe, the columns right of the split show the reference.
+      const ref = splitAt !== undefined && p % W >= splitAt;
+      const c = ref ? pixel("image", r, r, 3 * p) : pixel(v, x, r, 3 * p);
       out.data[4 * p] = c[0]; out.data[4 * p + 1] = c[1]; out.data[4 * p + 2] = c[2];
       out.data[4 * p + 3] = 255;
     }
     ctx.putImageData(out, 0, 0);
+  }
+  function place() {
+    const t = "translate(" + panX + "px," + panY + "px) scale(" + zoom + ")";
+    document.querySelectorAll(".view canvas").forEach((c) => { c.style.transform = t; });
+  }
+  function draw() {
+    const show = holdRef ? 0 : cur;
+    render($("canvas"), show, layout === "swipe" ? split : undefined);
+    $("pane2").style.display = layout === "side" ? "inline-block" : "none";
+    if (layout === "side") render($("canvas2"), 0);
+    place();
     document.querySelectorAll("#tabs button").forEach((b, i) => b.classList.toggle("on", i === show));
-    $("caption").textContent = DL.images[show].title + (view !== "image" ? " — " + view : "");
+    $("caption").textContent = DL.images[show].title + (view !== "image" ? " — " + view : "") +
+      (layout === "side" ? " | reference" : layout === "swipe" ? " / reference (swipe)" : "");
     $("bar").style.display = view === "image" ? "none" : "block";
+    $("imgmetrics").textContent = DL.images[show].metrics
+      .map((m) => m[0] + " " + (Math.abs(m[1]) >= 1e4 || Math.abs(m[1]) < 1e-2 ? m[1].toExponential(3) : m[1].toPrecision(4)))
+      .join("   ");
+  }
+  // Sortable tables: a click on a header sorts by that column (again: the other way).
+  function sortBy(table, col) {
+    const body = table.tBodies[0];
+    const rows = Array.from(body.rows);
+    const key = (r) => { const c = r.cells[col]; return c.dataset.v !== undefined ? parseFloat(c.dataset.v) : c.textContent; };
+    const asc = table.dataset.col !== String(col) || table.dataset.dir !== "asc";
+    rows.sort((a, b) => { const x = key(a), y = key(b); return (x < y ? -1 : x > y ? 1 : 0) * (asc ? 1 : -1); });
+    rows.forEach((r) => body.appendChild(r));
+    table.dataset.col = String(col); table.dataset.dir = asc ? "asc" : "desc";
   }
   function select(i) { if (i >= 0 && i < imgs.length) { cur = i; draw(); } }
   function setView(v) { view = v; draw(); }
+  function setLayout(l) { layout = l; draw(); }
+  function setZoom(z, cx, cy) {
+    // Keep the point under (cx, cy) where it is.
+    const nz = Math.min(64, Math.max(1, z));
+    panX = cx - (cx - panX) * nz / zoom; panY = cy - (cy - panY) * nz / zoom;
+    zoom = nz;
+    if (zoom === 1) { panX = 0; panY = 0; }
+    place();
+  }
 
   async function selftest() {
     const checks = [];
@@ -91,6 +129,31 @@
     setView("relmse"); ok("relMSE map", $("bar").style.display === "block");
     setView("signed"); ok("signed error map", $("caption").textContent.includes("signed"));
     setView("image"); select(1);
+    setLayout("side");
+    const ref0 = pixel("image", imgs[0], imgs[0], 3 * p).map(Math.round);
+    const b2 = Array.from($("canvas2").getContext("2d").getImageData(p % W, Math.floor(p / W), 1, 1).data);
+    ok("side by side shows the reference beside", $("pane2").style.display !== "none" &&
+       [0, 1, 2].every((c) => Math.abs(b2[c] - ref0[c]) <= 1));
+    setLayout("swipe"); split = (p % W) + 1; draw();
+    const left = shown();
+    split = p % W; draw();
+    const right = shown();
+    ok("the swipe shows the image left of the split and the reference right of it",
+       [0, 1, 2].every((c) => Math.abs(left[c] - want()[c]) <= 1 && Math.abs(right[c] - ref0[c]) <= 1));
+    setLayout("side"); setZoom(4, 0, 0);
+    ok("zoom is shared and nearest-neighbour",
+       $("canvas").style.transform === $("canvas2").style.transform &&
+       $("canvas").style.transform.includes("scale(4)") &&
+       getComputedStyle($("canvas")).imageRendering === "pixelated");
+    setZoom(1, 0, 0); setLayout("single");
+    ok("the image's metrics are shown", $("imgmetrics").textContent.includes("relMSE"));
+    const t = $("metrics");
+    if (t && t.tBodies[0].rows.length > 1) {
+      t.tHead.rows[0].cells[2].click();
+      const col = Array.from(t.tBodies[0].rows).map((r) => parseFloat(r.cells[2].dataset.v));
+      ok("a click sorts the table", col.every((v, i) => i === 0 || col[i - 1] <= v));
+    }
+    ok("the plots are in the page", document.querySelectorAll("figure.plot svg").length >= 2);
     const failed = checks.filter((c) => !c[1]).map((c) => c[0]);
     $("selftest").textContent = failed.length === 0
       ? "SELFTEST PASS " + checks.length + " checks"
@@ -103,6 +166,10 @@
     else if (e.key === "e") setView(view === "relmse" ? "image" : "relmse");
     else if (e.key === "s") setView(view === "signed" ? "image" : "signed");
     else if (e.key === "?") $("help").classList.toggle("on");
+    else if (e.key === "v") setLayout({ single: "side", side: "swipe", swipe: "single" }[layout]);
+    else if (e.key === "+" || e.key === "=") setZoom(zoom * 2, 0, 0);
+    else if (e.key === "-") setZoom(zoom / 2, 0, 0);
+    else if (e.key === "0") setZoom(1, 0, 0);
   });
   document.addEventListener("keyup", (e) => { if (e.key === "r") { holdRef = false; draw(); } });
 
@@ -118,6 +185,28 @@
         $("tabs").appendChild(b);
       });
       $("ev").oninput = draw;
+      document.querySelectorAll("table").forEach((t) => {
+        Array.from(t.tHead.rows[0].cells).forEach((th, i) => { th.onclick = () => sortBy(t, i); });
+      });
+      c.width = W; c.height = H; $("canvas2").width = W; $("canvas2").height = H;
+      document.querySelectorAll(".view").forEach((v) => {
+        v.addEventListener("wheel", (e) => {
+          e.preventDefault();
+          const r = v.getBoundingClientRect();
+          setZoom(e.deltaY < 0 ? zoom * 1.25 : zoom / 1.25, e.clientX - r.left, e.clientY - r.top);
+        });
+        let drag = null;
+        v.addEventListener("mousedown", (e) => { drag = [e.clientX - panX, e.clientY - panY]; });
+        window.addEventListener("mouseup", () => { drag = null; });
+        v.addEventListener("mousemove", (e) => {
+          if (drag) { panX = e.clientX - drag[0]; panY = e.clientY - drag[1]; place(); return; }
+          if (layout === "swipe") {
+            const r = $("canvas").getBoundingClientRect();
+            split = Math.max(0, Math.min(W, Math.floor((e.clientX - r.left) / r.width * W)));
+            draw();
+          }
+        });
+      });
       draw();
       if (location.hash === "#selftest") return selftest();
     })
