@@ -272,15 +272,25 @@ impl Setup {
         )
     }
 
-    /// The cached reference, rendered now if the cache lacks it.
-    fn reference(&self, opts: &RunOptions) -> Result<Reference, String> {
+    /// The reference if nothing has to be rendered: the closed form, or the cached render.
+    pub(crate) fn ready_reference(&self) -> Option<Reference> {
         match self.source {
-            RefSource::Constant(v) => Ok(cache::constant(
+            RefSource::Constant(v) => Some(cache::constant(
                 self.scene.camera.width,
                 self.scene.camera.height,
                 v,
                 self.key.clone(),
             )),
+            RefSource::Rendered { .. } => {
+                cache::cached(&self.dir.join("cache"), &self.key, self.eps)
+            }
+        }
+    }
+
+    /// The cached reference, rendered now if the cache lacks it (or `--fresh-reference`).
+    fn reference(&self, opts: &RunOptions) -> Result<Reference, String> {
+        match self.source {
+            RefSource::Constant(_) => Ok(self.ready_reference().expect("a closed form is ready")),
             RefSource::Rendered {
                 strategy,
                 spp,

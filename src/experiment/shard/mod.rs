@@ -11,8 +11,8 @@ pub mod status;
 pub mod unitfile;
 pub mod units;
 
-use super::cache::{self, Reference};
-use super::runner::{setup, RefSource, Setup};
+use super::cache::Reference;
+use super::runner::{setup, Setup};
 use super::{load, RunOptions};
 pub use status::{shards_of, status_of, Status};
 use std::path::{Path, PathBuf};
@@ -92,17 +92,7 @@ impl Planned {
     }
 
     fn merged_reference(&self) -> Option<Reference> {
-        match self.s.source {
-            RefSource::Constant(v) => Some(cache::constant(
-                self.s.scene.camera.width,
-                self.s.scene.camera.height,
-                v,
-                self.s.key.clone(),
-            )),
-            RefSource::Rendered { .. } => {
-                cache::cached(&self.s.dir.join("cache"), &self.s.key, self.s.eps)
-            }
-        }
+        self.s.ready_reference()
     }
 
     fn merged_marker(&self) -> PathBuf {
