@@ -19,7 +19,7 @@ use std::time::Instant;
 /// Merges the reference chunks in plan order (Chan's formula in f64) into the cache; errors
 /// name the missing or damaged units and the shards to rerun.
 pub(crate) fn merge_reference(p: &Planned) -> Result<Reference, String> {
-    if let Some(r) = p.merged_reference() {
+    if let Some(r) = p.s.ready_reference() {
         return Ok(r);
     }
     let RefSource::Rendered {

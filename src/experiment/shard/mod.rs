@@ -11,7 +11,6 @@ pub mod status;
 pub mod unitfile;
 pub mod units;
 
-use super::cache::Reference;
 use super::runner::{setup, Setup};
 use super::{load, RunOptions};
 pub use status::{shards_of, status_of, Status};
@@ -89,10 +88,6 @@ impl Planned {
 
     fn read(&self, i: usize) -> Result<UnitResult, String> {
         unitfile::read(&self.unit_path(i), self.owner(i))
-    }
-
-    fn merged_reference(&self) -> Option<Reference> {
-        self.s.ready_reference()
     }
 
     fn merged_marker(&self) -> PathBuf {

@@ -64,9 +64,6 @@ pub fn run_shard(
             .of_stage(stage)
             .filter(|&i| assignment[i] == shard.index)
             .collect();
-        if mine.is_empty() {
-            continue;
-        }
         let mut todo = Vec::new();
         for &i in &mine {
             match p.done(i) {
@@ -81,7 +78,7 @@ pub fn run_shard(
         if todo.is_empty() {
             continue;
         }
-        if stage == Stage::Reference && p.merged_reference().is_some() {
+        if stage == Stage::Reference && p.s.ready_reference().is_some() {
             skipped += todo.len();
             continue;
         }

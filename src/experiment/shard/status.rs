@@ -57,7 +57,7 @@ pub struct Status {
 }
 
 pub fn status_of(p: &Planned) -> Status {
-    let reference_merged = p.merged_reference().is_some();
+    let reference_merged = p.s.ready_reference().is_some();
     let stages = Stage::ALL
         .into_iter()
         .filter(|&st| p.plan.of_stage(st).next().is_some())
