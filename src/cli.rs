@@ -160,6 +160,7 @@ fn cmd_reproduce(a: &ReproduceArgs) -> Result<(), String> {
     let integrands = crate::integrands::report::IntegrandsArgs {
         quick: a.sweep.quick,
         out: a.sweep.out.clone(),
+        viewer: a.sweep.viewer,
         ..Default::default()
     };
     let ran = run_files(&files, &a.sweep);

@@ -1,9 +1,10 @@
-//! The HTML reports in a real browser: headless Chromium (Debian's `chromium`) loads each
-//! page `run --quick` writes with `#selftest`; the page switches images, changes the
-//! exposure, holds the reference and shows the error maps, checking its own canvas, and
-//! writes a pass/fail line this test reads. Any uncaught script error fails it, and a
-//! screenshot must not be blank. Without Chromium the test says why and is skipped, unless
-//! DIRECTLAB_REQUIRE_CHROMIUM=1 (set by `.ci/run` once it is installed).
+//! The HTML reports in a real browser: headless Chromium (Debian's `chromium`) loads every
+//! page `reproduce --quick`, `extreme --quick` and `chi2` write, with `#selftest`. A sweep's
+//! page switches images, changes the exposure, holds the reference and shows the error maps,
+//! checking its own canvas; every page sorts its tables and checks that its figures are all
+//! there and load. The page writes a pass/fail line this test reads; any uncaught script error
+//! fails it, and a screenshot must not be blank. Without Chromium the test says why and is
+//! skipped, unless DIRECTLAB_REQUIRE_CHROMIUM=1 (set by `.ci/run` once it is installed).
 
 mod common;
 use common::{directlab, repo, run, scratch};
@@ -30,7 +31,8 @@ fn chromium() -> Option<&'static str> {
     found
 }
 
-fn selftest(browser: &str, page: &Path) {
+/// The page's own pass/fail line, and chromium's log.
+fn selftest_line(browser: &str, page: &Path) -> (String, String) {
     let url = format!("file://{}#selftest", page.display());
     let o = Command::new(browser)
         .args([
@@ -45,12 +47,17 @@ fn selftest(browser: &str, page: &Path) {
         .output()
         .expect("run chromium");
     let dom = String::from_utf8_lossy(&o.stdout);
-    let log = String::from_utf8_lossy(&o.stderr);
     let line = dom
         .split("<div id=\"selftest\">")
         .nth(1)
         .and_then(|s| s.split('<').next())
-        .unwrap_or("");
+        .unwrap_or("")
+        .to_string();
+    (line, String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+fn selftest(browser: &str, page: &Path) {
+    let (line, log) = selftest_line(browser, page);
     assert!(
         line.starts_with("SELFTEST PASS"),
         "{}: '{line}'\n{log}",
@@ -89,21 +96,102 @@ fn screenshot_not_blank(browser: &str, page: &Path, shot: &Path) {
     );
 }
 
+/// Every `index.html` one folder below `root`.
+fn pages(root: &Path) -> Vec<std::path::PathBuf> {
+    let mut v: Vec<_> = std::fs::read_dir(root)
+        .unwrap()
+        .flatten()
+        .map(|d| d.path().join("index.html"))
+        .filter(|p| p.exists())
+        .collect();
+    v.sort();
+    v
+}
+
 #[test]
 fn report_pages_test_themselves_in_chromium() {
     let Some(browser) = chromium() else {
         return;
     };
     let out = scratch("browser");
-    for exp in ["experiments/fig2.toml", "experiments/fig3.toml"] {
-        let o = run(directlab()
-            .args(["run", repo(exp).to_str().unwrap(), "--quick", "--out"])
-            .arg(&out));
-        assert!(o.status.success());
+    let cli = |args: &[&str]| {
+        let o = run(directlab().args(args).arg("--out").arg(&out));
+        assert!(o.status.success(), "{args:?}");
+    };
+    cli(&["reproduce", "--quick"]);
+    cli(&["extreme", "--quick"]);
+    let chi2 = out.join("chi2");
+    let o = run(directlab()
+        .args([
+            "chi2",
+            "warp/uniform",
+            "--samples",
+            "20000",
+            "--resolution",
+            "11",
+        ])
+        .arg("--out")
+        .arg(&chi2));
+    assert!(o.status.success());
+    let found = pages(&out);
+    let names: Vec<String> = found
+        .iter()
+        .map(|p| {
+            p.parent()
+                .unwrap()
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
+    for want in [
+        "fig1-quick",
+        "fig2-quick",
+        "fig3-quick",
+        "fig4-quick",
+        "fig5-tiles-quick",
+        "integrands-quick",
+        "extreme-quick",
+        "chi2",
+    ] {
+        assert!(
+            names.iter().any(|n| n == want),
+            "no {want} page in {names:?}"
+        );
     }
-    for name in ["fig2-quick", "fig3-quick"] {
-        let page = out.join(name).join("index.html");
-        selftest(browser, &page);
-        screenshot_not_blank(browser, &page, &out.join(format!("{name}.png")));
+    for page in &found {
+        selftest(browser, page);
     }
+    let root = out.join("index.html");
+    let index = std::fs::read_to_string(&root).unwrap();
+    assert!(index.contains("href=\"fig3-quick/index.html\""), "{index}");
+    let fig3 = out.join("fig3-quick/index.html");
+    screenshot_not_blank(browser, &fig3, &out.join("fig3-quick.png"));
+}
+
+/// The checks can fail: a page whose linked figure is gone says so.
+#[test]
+fn a_page_with_a_missing_figure_fails_its_selftest() {
+    let Some(browser) = chromium() else {
+        return;
+    };
+    let out = scratch("browser-missing");
+    let o = run(directlab()
+        .args([
+            "run",
+            repo("experiments/fig3.toml").to_str().unwrap(),
+            "--quick",
+        ])
+        .args(["--viewer", "none", "--out"])
+        .arg(&out));
+    assert!(o.status.success());
+    let page = out.join("fig3-quick/index.html");
+    selftest(browser, &page);
+    std::fs::remove_file(out.join("fig3-quick/convergence.png")).unwrap();
+    let (line, _) = selftest_line(browser, &page);
+    assert!(
+        line.starts_with("SELFTEST FAIL") && line.contains("every figure loads"),
+        "'{line}'"
+    );
 }

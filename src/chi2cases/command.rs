@@ -47,6 +47,9 @@ pub struct Chi2Args {
     /// Set a scene parameter declared with <default>: -D name=value (repeatable).
     #[arg(short = 'D', value_parser = crate::scene::loader::parse_define)]
     pub define: Vec<(String, String)>,
+    /// `none`: the HTML report links the failures' heat maps instead of carrying them.
+    #[arg(long, value_enum, default_value_t)]
+    pub viewer: crate::report::html::Viewer,
 }
 
 /// The largest `--resolution`: its tables stay within a few hundred MB per case in flight.
@@ -144,6 +147,70 @@ pub fn write_csv(path: &Path, rows: &[Timed], cfg: &CaseConfig) -> Result<(), St
     })
 }
 
+/// `index.md`: the settings, the failures with their heat maps, and every case's result
+/// (each linking its heat map; embedding all of them would make a page of several MB).
+pub fn markdown(rows: &[Timed], cfg: &CaseConfig, family_alpha: f64) -> String {
+    use std::fmt::Write;
+    let failed: Vec<&Timed> = rows.iter().filter(|t| !t.outcome.passed()).collect();
+    let mut md = String::from("# Chi-square tests of the sampling routines\n\n");
+    let _ = writeln!(
+        md,
+        "{} cases, {} samples each on {} cells along v, seed {}. Significance: alpha = \
+         {family_alpha} for the whole run, Sidak-corrected to {:.3e} per case, so a correct \
+         implementation fails a run with probability {family_alpha}. Each heat map shows the \
+         observed histogram, the pdf's expected counts and their residual.\n",
+        rows.len(),
+        cfg.samples,
+        cfg.resolution,
+        cfg.seed,
+        cfg.alpha
+    );
+    if failed.is_empty() {
+        let _ = writeln!(md, "**All {} cases passed.**\n", rows.len());
+    } else {
+        let _ = writeln!(
+            md,
+            "**{} of {} cases failed.**\n\n## Failures\n",
+            failed.len(),
+            rows.len()
+        );
+        for t in &failed {
+            let o = &t.outcome;
+            let _ = writeln!(
+                md,
+                "### {}\n\n{}\n\n![{} heat map]({}.png)\n",
+                o.name,
+                o.summary().replace('|', "/"),
+                o.name,
+                o.name
+            );
+        }
+    }
+    let _ = writeln!(
+        md,
+        "## Cases\n\n| case | domain | statistic | dof | p-value | threshold | verdict | seconds |\n\
+         |---|---|---:|---:|---:|---:|---|---:|"
+    );
+    for t in rows {
+        let (o, c) = (&t.outcome, &t.outcome.chi2);
+        let _ = writeln!(
+            md,
+            "| [{}]({}.png) | {} | {:.2} | {} | {:.3e} | {:.3e} | {} | {:.2} |",
+            o.name,
+            o.name,
+            c.domain,
+            c.statistic,
+            c.dof,
+            c.p_value,
+            c.threshold,
+            verdict(o),
+            t.seconds
+        );
+    }
+    md.push_str("\nRaw numbers: [results.csv](results.csv).\n");
+    md
+}
+
 /// The printed table.
 pub fn table(rows: &[Timed]) -> String {
     let width = rows
@@ -230,7 +297,7 @@ pub fn run(a: &Chi2Args) -> Result<bool, String> {
         alpha: sidak(ALPHA, cases.len()),
         ..CaseConfig::default()
     };
-    run_cases(&cases, &cfg, ALPHA, &out)
+    run_cases(&cases, &cfg, ALPHA, &out, a.viewer)
 }
 
 /// Runs `cases` (in parallel) with `cfg`, whose `alpha` is the per-case level that makes
@@ -241,6 +308,7 @@ pub fn run_cases(
     cfg: &CaseConfig,
     family_alpha: f64,
     out: &Path,
+    viewer: crate::report::html::Viewer,
 ) -> Result<bool, String> {
     eprintln!(
         "{} cases, {} samples each, resolution {}, seed {}; alpha {family_alpha} \
@@ -272,6 +340,8 @@ pub fn run_cases(
     }
     let csv = out.join("results.csv");
     write_csv(&csv, &rows, cfg)?;
+    let md = markdown(&rows, cfg, family_alpha);
+    crate::report::write_report(out, &md, None, viewer)?;
     let failed: Vec<&Timed> = rows.iter().filter(|t| !t.outcome.passed()).collect();
     for t in &failed {
         println!("FAIL {}: {}", t.outcome.name, t.outcome.summary());
@@ -305,6 +375,7 @@ mod tests {
             emitter_selection: crate::emitter::EmitterSelection::Uniform,
             light_sampling: crate::emitter::LightSampling::Area,
             define: vec![],
+            viewer: Default::default(),
         };
         // 20k samples on 11 x 11 cells at alpha 0.01: a correct warp passes.
         assert_eq!(run(&args), Ok(true));
@@ -314,6 +385,13 @@ mod tests {
         assert!(lines[0].starts_with("case,domain,samples,resolution,seed,statistic,dof,p_value"));
         assert!(lines[1].starts_with("warp/uniform-disk,unit disk,20000,11,3,"));
         assert!(png_path(&dir, "warp/uniform-disk").exists());
+        let md = std::fs::read_to_string(dir.join("index.md")).unwrap();
+        assert!(md.contains("**All 1 cases passed.**"), "{md}");
+        assert!(
+            md.contains("| [warp/uniform-disk](warp/uniform-disk.png) | unit disk |"),
+            "{md}"
+        );
+        assert!(dir.join("index.html").exists());
         let none = Chi2Args {
             filter: Some("no-such-case".into()),
             ..args
@@ -328,10 +406,22 @@ mod tests {
             ..CaseConfig::default()
         });
         o.chi2.verdict = crate::stats::Verdict::Fail;
-        let t = table(&[Timed {
+        let timed = [Timed {
             outcome: o,
             seconds: 0.0,
-        }]);
+        }];
+        let t = table(&timed);
         assert!(t.lines().nth(1).unwrap().ends_with("FAIL"), "{t}");
+        // The report shows a failure's heat map and says how many failed.
+        let md = markdown(&timed, &CaseConfig::default(), ALPHA);
+        assert!(md.contains("**1 of 1 cases failed.**"), "{md}");
+        assert!(
+            md.contains("## Failures\n\n### warp/uniform-disk\n"),
+            "{md}"
+        );
+        assert!(
+            md.contains("![warp/uniform-disk heat map](warp/uniform-disk.png)"),
+            "{md}"
+        );
     }
 }

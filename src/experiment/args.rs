@@ -25,6 +25,10 @@ pub struct SweepArgs {
     /// done, report written, finished); the other output goes to stderr.
     #[arg(long)]
     pub json: bool,
+    /// `none`: HTML reports without embedded images (no image viewer; figures linked beside
+    /// the page), for small pages.
+    #[arg(long, value_enum, default_value_t)]
+    pub viewer: crate::report::html::Viewer,
 }
 
 /// The runner's options from the command line's (and `--json` switched on for the
@@ -35,5 +39,6 @@ pub fn options(a: &SweepArgs) -> RunOptions {
         out: a.out.clone(),
         threads: a.threads,
         fresh_reference: a.fresh_reference,
+        viewer: a.viewer,
     }
 }

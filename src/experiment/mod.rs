@@ -32,16 +32,16 @@ pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(),
     if exp.exp.probe.is_some() {
         return probe::run_and_report(exp, opts);
     }
-    report_outcome(&run_experiment(exp, opts)?)
+    report_outcome(&run_experiment(exp, opts)?, opts.viewer)
 }
 
 /// Writes the figures and report of a finished sweep and prints its summary.
-pub fn report_outcome(o: &Outcome) -> Result<(), String> {
+pub fn report_outcome(o: &Outcome, viewer: crate::report::html::Viewer) -> Result<(), String> {
     results::write_long(&o.dir.join("metrics.csv"), &o.rows)?;
     events::write_jsonl(&o.dir.join("results.jsonl"), &o.rows)?;
     let (series, mut figs) = figures::charts(o)?;
     figs.extend(figures::images(o)?);
-    crate::report::write_experiment(o, &series, &figs)?;
+    crate::report::write_experiment(o, &series, &figs, viewer)?;
     for l in crate::report::mean_check_lines(o) {
         events::say(&format!("{}: {l}", o.exp.name));
     }

@@ -27,6 +27,8 @@ pub struct RunOptions {
     pub threads: Option<usize>,
     /// Re-render the reference even if a cached one matches.
     pub fresh_reference: bool,
+    /// What the HTML reports carry.
+    pub viewer: crate::report::html::Viewer,
 }
 
 /// Everything the figures and the report need.

@@ -28,6 +28,9 @@ pub struct IntegrandsArgs {
     /// `<out>/integrands-quick/`.
     #[arg(long)]
     pub quick: bool,
+    /// `none`: the HTML report links its figures instead of carrying them.
+    #[arg(long, value_enum, default_value_t)]
+    pub viewer: crate::report::html::Viewer,
 }
 
 impl Default for IntegrandsArgs {
@@ -38,6 +41,7 @@ impl Default for IntegrandsArgs {
             samplers: Vec::new(),
             out: PathBuf::from("reports"),
             quick: false,
+            viewer: Default::default(),
         }
     }
 }
@@ -93,10 +97,8 @@ pub fn run(a: &IntegrandsArgs) -> Result<PathBuf, String> {
     let pixel_counts = sample_counts(a.max_n.min(1024));
     let pixel_cells = pixel::measure(&pixel_counts, a.seeds)?;
     md += &pixel_section(&dir, &pixel_cells, &pixel_counts, a.seeds)?;
+    crate::report::write_report(&dir, &md, None, a.viewer)?;
     let path = dir.join("index.md");
-    write_atomic(&path, |tmp| {
-        std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display()))
-    })?;
     eprintln!(
         "integrands: {} samplers x {} counts x {} seeds in {:.1} s; report in {}",
         samplers.len(),

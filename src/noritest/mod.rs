@@ -102,5 +102,11 @@ fn run_chi2(f: &parse::TestFile, a: &TestArgs) -> Result<bool, String> {
         ..CaseConfig::default()
     };
     let stem = f.path.file_stem().unwrap_or_default().to_string_lossy();
-    run_cases(&cases, &cfg, f.alpha, &a.out.join(stem.as_ref()))
+    run_cases(
+        &cases,
+        &cfg,
+        f.alpha,
+        &a.out.join(stem.as_ref()),
+        Default::default(),
+    )
 }

@@ -1,4 +1,4 @@
-//! Markdown reports: `reports/<experiment>/index.md` (settings, reference and its noise,
+//! Reports: `reports/<experiment>/index.md` (and the same as `index.html`) (settings, reference and its noise,
 //! what was left out and why, tables, figures) and `reports/index.md` linking them all.
 
 pub mod html;
@@ -130,8 +130,13 @@ pub fn direct_part_note(integrator: &str) -> String {
     )
 }
 
-/// Writes `<dir>/index.md`.
-pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> Result<(), String> {
+/// Writes `<dir>/index.md` and `<dir>/index.html`.
+pub fn write_experiment(
+    o: &Outcome,
+    series: &[Series],
+    figures: &[Figure],
+    viewer: html::Viewer,
+) -> Result<(), String> {
     let mut md = String::new();
     let title = o.title();
     let _ = writeln!(md, "# {title}\n");
@@ -158,11 +163,25 @@ pub fn write_experiment(o: &Outcome, series: &[Series], figures: &[Figure]) -> R
         md,
         "Raw numbers: [results.csv](results.csv), one row per render."
     );
-    let path = o.dir.join("index.md");
+    let top = match viewer {
+        html::Viewer::Full => Some(html::sweep::section(o)?),
+        html::Viewer::None => None,
+    };
+    write_report(&o.dir, &md, top.as_ref(), viewer)
+}
+
+/// Writes a report as `<dir>/index.md` and `<dir>/index.html` (with `top` above the report).
+pub fn write_report(
+    dir: &Path,
+    md: &str,
+    top: Option<&html::Section>,
+    viewer: html::Viewer,
+) -> Result<(), String> {
+    let path = dir.join("index.md");
     write_atomic(&path, |tmp| {
-        std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display()))
+        std::fs::write(tmp, md).map_err(|e| format!("{}: {e}", path.display()))
     })?;
-    html::page::write(o)
+    html::write(dir, md, top, viewer.figures())
 }
 
 /// Writes `<root>/index.md` linking every report under `root`: each folder's `index.md`
@@ -200,7 +219,7 @@ pub fn write_root_index(root: &Path) -> Result<(), String> {
     write_atomic(&path, |tmp| {
         std::fs::write(tmp, &md).map_err(|e| format!("{}: {e}", path.display()))
     })?;
-    html::page::write_root(root, &entries)
+    html::write_root(root, &entries)
 }
 
 #[cfg(test)]

@@ -5,7 +5,6 @@
 pub use super::probe_table::{critical, table, table_spp, TableRow, BIASED, NON_FINITE, OK, TAIL};
 use crate::experiment::analysis::metric_name;
 use crate::experiment::probe::run::ProbeOutcome;
-use crate::output::write_atomic;
 use std::fmt::Write as _;
 
 fn sci(x: f64) -> String {
@@ -238,8 +237,12 @@ fn checks(md: &mut String, o: &ProbeOutcome) {
     md.push('\n');
 }
 
-/// Writes `<dir>/index.md`.
-pub fn write(o: &ProbeOutcome, figure: Option<&str>) -> Result<(), String> {
+/// Writes `<dir>/index.md` and `<dir>/index.html`.
+pub fn write(
+    o: &ProbeOutcome,
+    figure: Option<&str>,
+    viewer: super::html::Viewer,
+) -> Result<(), String> {
     let t = table(o);
     let mut md = String::new();
     let x = &o.exp.exp;
@@ -276,8 +279,5 @@ pub fn write(o: &ProbeOutcome, figure: Option<&str>) -> Result<(), String> {
          reference values and their closed forms: `{}`.",
         o.exp.file.display()
     );
-    let path = o.dir.join("index.md");
-    write_atomic(&path, |tmp| {
-        std::fs::write(tmp, &md).map_err(|err| format!("{}: {err}", path.display()))
-    })
+    super::write_report(&o.dir, &md, None, viewer)
 }

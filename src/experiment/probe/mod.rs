@@ -22,7 +22,7 @@ use super::RunOptions;
 pub fn run_and_report(exp: super::Resolved, opts: &RunOptions) -> Result<(), String> {
     let o = run_probe(exp, opts)?;
     let figure = figure::write(&o)?;
-    crate::report::probe::write(&o, figure.as_deref())?;
+    crate::report::probe::write(&o, figure.as_deref(), opts.viewer)?;
     super::events::write_jsonl(&o.dir.join("results.jsonl"), &o.rows)?;
     super::events::emit(
         "report_written",

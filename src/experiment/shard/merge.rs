@@ -156,7 +156,7 @@ pub fn merge(
     results.save(&csv)?;
     let marker = p.merged_marker();
     let o = crate::experiment::Outcome::of(p.s, reference, results.rows, start);
-    crate::experiment::report_outcome(&o)?;
+    crate::experiment::report_outcome(&o, opts.viewer)?;
     std::fs::write(&marker, "merged\n").map_err(|e| format!("{}: {e}", marker.display()))?;
     Ok(())
 }
