@@ -195,3 +195,35 @@ fn a_page_with_a_missing_figure_fails_its_selftest() {
         "'{line}'"
     );
 }
+
+/// Writes `reports/readme/fig3-page.png`, the README's picture: the committed Figure 3 page
+/// with light sampling beside the reference, scaled down, in grey. Run after `reproduce` with
+/// `cargo test --release --test browser -- --ignored`.
+#[test]
+#[ignore]
+fn regenerate_readme_screenshot() {
+    let browser = chromium().expect("chromium");
+    let page = repo("reports/fig3/index.html");
+    let shot = scratch("readme").join("shot.png");
+    let o = Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--hide-scrollbars",
+            "--window-size=1600,740",
+            "--virtual-time-budget=10000",
+        ])
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(format!("file://{}#image=2&layout=side", page.display()))
+        .output()
+        .expect("run chromium");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let img = image::open(&shot).unwrap();
+    let small = img.resize(960, 960, image::imageops::FilterType::Lanczos3);
+    // The scene is grey: one channel keeps the picture and a third of the bytes.
+    small
+        .to_luma8()
+        .save(repo("reports/readme/fig3-page.png"))
+        .unwrap();
+}

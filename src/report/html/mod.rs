@@ -65,7 +65,7 @@ pub fn page(dir: &Path, md: &str, top: Option<&Section>, figures: Figures) -> St
         r#"<!doctype html>
 <html lang="en"><head><meta charset="utf-8"><title>{t}</title>
 <style>
-body {{ font: 14px sans-serif; margin: 1em; background: #fafafa; max-width: 1400px; }}
+body {{ font: 14px sans-serif; margin: 1em; background: #fafafa; }} #doc {{ max-width: 1400px; }}
 table {{ border-collapse: collapse; margin: 0.5em 0; }}
 td, th {{ border: 1px solid #ccc; padding: 2px 6px; }} th {{ cursor: pointer; background: #eee; }}
 span.plot svg {{ width: 560px; height: auto; margin: 4px; }} img {{ max-width: 100%; }}

@@ -146,7 +146,8 @@ canvas {{ image-rendering: pixelated; width: {cw}px; transform-origin: 0 0; disp
     };
     let html = format!(
         r#"<p>Keys: 1-9 choose an image, hold R for the reference, V side by side / swipe, E relMSE map,
-S signed error, wheel or +/- zoom (drag to pan, 0 resets), ? help.{resolution}</p>
+S signed error, wheel or +/- zoom (drag to pan, 0 resets), ? help. A link can choose the
+state: <code>#image=3&amp;layout=side&amp;view=relmse&amp;ev=1</code>.{resolution}</p>
 <div id="help"><pre>1-9  image      R (hold)  reference      E  relMSE map (log10, decades {lo} to {hi})
 S    signed error (blue: too dark, red: too bright; +-100 %)      ?  this help
 V    one image / side by side with the reference / swipe (the mouse moves the split)

@@ -184,6 +184,12 @@
           }
         });
       });
+      // A link can open a chosen state: #image=3&layout=side&view=relmse&ev=1.
+      const want = new URLSearchParams(location.hash.slice(1));
+      if (want.has("image")) cur = Math.min(imgs.length - 1, Math.max(0, parseInt(want.get("image"), 10) - 1 || 0));
+      if (["single", "side", "swipe"].includes(want.get("layout"))) layout = want.get("layout");
+      if (["image", "relmse", "signed"].includes(want.get("view"))) view = want.get("view");
+      if (want.has("ev")) $("ev").value = want.get("ev");
       draw();
       if (location.hash === "#selftest") return selftest();
     })
