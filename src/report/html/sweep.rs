@@ -1,5 +1,5 @@
 //! The image viewer of an image sweep's page: the reference and each strategy's seed-0 image
-//! at the comparison spp and at equal time, as HDR data tone-mapped in the page
+//! at the comparison spp, at the progression's spp and at equal time, as HDR data tone-mapped in the page
 //! ([`super::data`], `viewer.js`).
 
 use super::{data, Section};
@@ -27,15 +27,24 @@ fn images(o: &Outcome) -> Result<Vec<Shown<'_>>, String> {
         o.reference.mean.clone(),
         None,
     )];
-    let spp = o.exp.equal_spp();
-    for (label, name) in &o.strategies {
-        let p = image_path(&o.dir, label, &spp_tag(spp), 0);
-        if p.exists() {
-            let row = o
-                .rows
-                .iter()
-                .find(|r| r.is_sweep() && &r.strategy == label && r.spp == spp && r.seed == 0);
-            v.push((format!("{name}, {spp} spp"), load_image(&p)?.0, row));
+    // The comparison spp first (keys 1-9 flip between strategies there), then the
+    // progression's other spp.
+    let first = o.exp.equal_spp();
+    let mut spps: Vec<u32> = o.exp.exp.figures.progression.clone();
+    spps.sort_unstable();
+    spps.dedup();
+    spps.retain(|&s| s != first);
+    spps.insert(0, first);
+    for spp in spps {
+        for (label, name) in &o.strategies {
+            let p = image_path(&o.dir, label, &spp_tag(spp), 0);
+            if p.exists() {
+                let row = o
+                    .rows
+                    .iter()
+                    .find(|r| r.is_sweep() && &r.strategy == label && r.spp == spp && r.seed == 0);
+                v.push((format!("{name}, {spp} spp"), load_image(&p)?.0, row));
+            }
         }
     }
     if let Some(et) = &o.exp.exp.equal_time {
@@ -145,10 +154,10 @@ canvas {{ image-rendering: pixelated; width: {cw}px; transform-origin: 0 0; disp
         String::new()
     };
     let html = format!(
-        r#"<p>Keys: 1-9 choose an image, hold R for the reference, V side by side / swipe, E relMSE map,
+        r#"<p>Keys: 1-9 choose an image (arrows: next, previous), hold R for the reference, V side by side / swipe, E relMSE map,
 S signed error, wheel or +/- zoom (drag to pan, 0 resets), ? help. A link can choose the
 state: <code>#image=3&amp;layout=side&amp;view=relmse&amp;ev=1</code>.{resolution}</p>
-<div id="help"><pre>1-9  image      R (hold)  reference      E  relMSE map (log10, decades {lo} to {hi})
+<div id="help"><pre>1-9  image   &larr; &rarr;  previous, next image   R (hold)  reference      E  relMSE map (log10, decades {lo} to {hi})
 S    signed error (blue: too dark, red: too bright; +-100 %)      ?  this help
 V    one image / side by side with the reference / swipe (the mouse moves the split)
 + -  zoom (also the mouse wheel; nearest-neighbour, shared by both panes)   0  reset zoom

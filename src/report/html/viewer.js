@@ -101,6 +101,10 @@
     ok("images decoded", imgs.length === DL.images.length && imgs[0].length === W * H * 3);
     select(1);
     ok("switching shows the second image", $("caption").textContent.startsWith(DL.images[1].title));
+    document.dispatchEvent(new KeyboardEvent("keydown", { key: "ArrowLeft" }));
+    ok("the left arrow goes back to the reference", $("caption").textContent.startsWith(DL.images[0].title));
+    document.dispatchEvent(new KeyboardEvent("keydown", { key: "ArrowRight" }));
+    ok("the right arrow goes forward", $("caption").textContent.startsWith(DL.images[1].title));
     // A mid-tone pixel the page writer chose and tone-mapped itself (film::to_srgb8 of the
     // RGBE value): the canvas must show those bytes.
     const p = DL.check.pixel;
@@ -143,6 +147,8 @@
   }
   document.addEventListener("keydown", (e) => {
     if (e.key >= "1" && e.key <= "9") select(parseInt(e.key, 10) - 1);
+    else if (e.key === "ArrowRight") select((cur + 1) % imgs.length);
+    else if (e.key === "ArrowLeft") select((cur + imgs.length - 1) % imgs.length);
     else if (e.key === "r" && !holdRef) { holdRef = true; draw(); }
     else if (e.key === "e") setView(view === "relmse" ? "image" : "relmse");
     else if (e.key === "s") setView(view === "signed" ? "image" : "signed");

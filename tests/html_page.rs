@@ -1,6 +1,7 @@
-//! The HTML report's size at a bundled resolution: Figure 3's page (Veach's scene at its own
-//! 768x512, every strategy's image at the comparison spp and at equal time, embedded as HDR
-//! data) stays a few MB; with `--viewer none` it carries no image data at all.
+//! The HTML report's images and size. Figure 1's page shows the progression's spp after the
+//! comparison spp. Figure 3's page at a bundled resolution (Veach's scene at its own 768x512,
+//! every strategy's image at the comparison spp and at equal time, embedded as HDR data)
+//! stays a few MB; with `--viewer none` it carries no image data at all.
 
 mod common;
 use common::{directlab, repo, run, scratch};
@@ -65,4 +66,34 @@ fn fig3_page_at_its_bundled_resolution_stays_a_few_mb() {
     );
     eprintln!("with --viewer none: {} KB", bare.len() / 1000);
     assert!(bare.len() < 200_000, "{} bytes", bare.len());
+}
+
+#[test]
+fn fig1_page_shows_the_comparison_spp_then_the_progression() {
+    let out = scratch("html-fig1");
+    let o = run(directlab()
+        .args([
+            "run",
+            repo("experiments/fig1.toml").to_str().unwrap(),
+            "--quick",
+            "--out",
+        ])
+        .arg(&out));
+    assert!(o.status.success());
+    let page = std::fs::read_to_string(out.join("fig1-quick/index.html")).unwrap();
+    let titles: Vec<&str> = page
+        .split("\"title\":\"")
+        .skip(1)
+        .map(|t| t.split('"').next().unwrap())
+        .collect();
+    // fig1.toml --quick: equal_spp 4, progression [1, 16], one strategy, no equal time.
+    assert_eq!(
+        titles,
+        [
+            "reference (256 spp)",
+            "light sampling, 4 spp",
+            "light sampling, 1 spp",
+            "light sampling, 16 spp"
+        ]
+    );
 }
