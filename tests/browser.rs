@@ -166,6 +166,10 @@ fn report_pages_test_themselves_in_chromium() {
     let root = out.join("index.html");
     let index = std::fs::read_to_string(&root).unwrap();
     assert!(index.contains("href=\"fig3-quick/index.html\""), "{index}");
+    assert!(
+        index.contains("href=\"chi2/index.html\""),
+        "chi2 joins the index: {index}"
+    );
     let fig3 = out.join("fig3-quick/index.html");
     screenshot_not_blank(browser, &fig3, &out.join("fig3-quick.png"));
 }

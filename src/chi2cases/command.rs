@@ -342,6 +342,10 @@ pub fn run_cases(
     write_csv(&csv, &rows, cfg)?;
     let md = markdown(&rows, cfg, family_alpha);
     crate::report::write_report(out, &md, None, viewer)?;
+    // In a reports root (such as `reports/`), its index now lists this page.
+    if let Some(root) = out.parent().filter(|p| p.join("index.md").exists()) {
+        crate::report::write_root_index(root)?;
+    }
     let failed: Vec<&Timed> = rows.iter().filter(|t| !t.outcome.passed()).collect();
     for t in &failed {
         println!("FAIL {}: {}", t.outcome.name, t.outcome.summary());

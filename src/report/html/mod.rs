@@ -74,13 +74,19 @@ span.plot svg {{ width: 560px; height: auto; margin: 4px; }} img {{ max-width: 1
 <h1>{t}</h1>
 {top}<div id="doc">
 {body}</div>
-<p><a href="index.md">Markdown</a> · <a href="../index.html">all reports</a></p>
+<p><a href="index.md">Markdown</a>{up}</p>
 <div id="selftest"></div>
 <script>const DOC = {doc};
 {DOC}</script>
 {script}</body></html>
 "#,
         t = escape(title),
+        // The reports root's index, where this page sits in one.
+        up = if dir.parent().is_some_and(|p| p.join("index.md").exists()) {
+            " · <a href=\"../index.html\">all reports</a>"
+        } else {
+            ""
+        },
         css = top.map_or("", |s| &s.css),
         top = top.map_or("", |s| &s.html),
         script = top.map_or(String::new(), |s| format!(
@@ -126,4 +132,25 @@ pub fn write_root(root: &Path, entries: &[(String, String)]) -> Result<(), Strin
     crate::output::write_atomic(&path, |tmp| {
         std::fs::write(tmp, &page).map_err(|e| format!("{}: {e}", path.display()))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_page_links_the_reports_index_only_inside_a_reports_root() {
+        let root = std::env::temp_dir().join(format!("directlab-page-{}", std::process::id()));
+        let dir = root.join("exp");
+        std::fs::create_dir_all(&dir).unwrap();
+        let md = "# A <title>\n\n| x |\n|---|\n| 1 |\n";
+        let alone = page(&dir, md, None, Figures::Embed);
+        assert!(alone.contains("<h1>A &lt;title&gt;</h1>"), "{alone}");
+        assert!(alone.contains("\"tables\":1"), "{alone}");
+        assert!(!alone.contains("all reports"), "{alone}");
+        std::fs::write(root.join("index.md"), "# Reports\n").unwrap();
+        let inside = page(&dir, md, None, Figures::Embed);
+        assert!(inside.contains("<a href=\"../index.html\">all reports</a>"));
+        std::fs::remove_dir_all(&root).unwrap();
+    }
 }
