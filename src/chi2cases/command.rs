@@ -156,9 +156,11 @@ pub fn markdown(rows: &[Timed], cfg: &CaseConfig, family_alpha: f64) -> String {
     let _ = writeln!(
         md,
         "{} cases, {} samples each on {} cells along v, seed {}. Significance: alpha = \
-         {family_alpha} for the whole run, Sidak-corrected to {:.3e} per case, so a correct \
-         implementation fails a run with probability {family_alpha}. Each heat map shows the \
-         observed histogram, the pdf's expected counts and their residual.\n",
+         {family_alpha} for the whole run, Sidak-corrected to {:.3e} per case (a continuous \
+         case shares it, Sidak again, between its chi-square test and the check of the pdf's \
+         integral: hence the threshold column), so a correct implementation fails a run with \
+         probability {family_alpha}. Each heat map shows the observed histogram, the pdf's \
+         expected counts and their residual.\n",
         rows.len(),
         cfg.samples,
         cfg.resolution,
