@@ -70,20 +70,27 @@ fn selftest(browser: &str, page: &Path) {
     );
 }
 
-fn screenshot_not_blank(browser: &str, page: &Path, shot: &Path) {
+/// Chromium's screenshot of `url` in a window of `size` ("W,H") into `shot`.
+fn screenshot(browser: &str, url: &str, size: &str, shot: &Path) {
     let o = Command::new(browser)
         .args([
             "--headless",
             "--no-sandbox",
             "--disable-gpu",
-            "--window-size=1000,800",
+            "--hide-scrollbars",
             "--virtual-time-budget=10000",
         ])
+        .arg(format!("--window-size={size}"))
         .arg(format!("--screenshot={}", shot.display()))
-        .arg(format!("file://{}", page.display()))
+        .arg(url)
         .output()
         .expect("run chromium");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+fn screenshot_not_blank(browser: &str, page: &Path, shot: &Path) {
+    let url = format!("file://{}", page.display());
+    screenshot(browser, &url, "1000,800", shot);
     let img = image::open(shot).unwrap().into_rgb8();
     let mut colours: Vec<[u8; 3]> = img.pixels().map(|p| p.0).collect();
     colours.sort();
@@ -209,20 +216,8 @@ fn regenerate_readme_screenshot() {
     let browser = chromium().expect("chromium");
     let page = repo("reports/fig3/index.html");
     let shot = scratch("readme").join("shot.png");
-    let o = Command::new(browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--hide-scrollbars",
-            "--window-size=1600,740",
-            "--virtual-time-budget=10000",
-        ])
-        .arg(format!("--screenshot={}", shot.display()))
-        .arg(format!("file://{}#image=2&layout=side", page.display()))
-        .output()
-        .expect("run chromium");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let url = format!("file://{}#image=2&layout=side", page.display());
+    screenshot(browser, &url, "1600,740", &shot);
     let img = image::open(&shot).unwrap();
     let small = img.resize(960, 960, image::imageops::FilterType::Lanczos3);
     // The scene is grey: one channel keeps the picture and a third of the bytes.
