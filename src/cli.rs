@@ -1,8 +1,10 @@
 //! Command-line interface.
 
+use crate::choices::{named, StrategyArgs};
 use crate::experiment::args::SweepArgs;
 use crate::film;
-use crate::integrator::{Strategy, StrategyOverrides};
+use crate::integrator::Strategy;
+use crate::named::Named;
 use crate::render::{render, RenderSettings};
 use clap::{Args, Parser, Subcommand};
 use std::io::IsTerminal;
@@ -30,12 +32,12 @@ pub enum Command {
     Reproduce(ReproduceArgs),
     /// Split an experiment into fixed units (reference chunks, sweep runs, equal-time runs)
     /// for `run --shard I/N`; writes <out>/<name>/plan.json.
-    Plan(crate::experiment::shard::cli::PlanArgs),
+    Plan(crate::pipeline::shard::PlanArgs),
     /// Combine the units of sharded runs, exactly and in plan order, into the reference,
     /// results.csv, figures and report a one-machine run writes.
-    Merge(crate::experiment::shard::cli::MergeArgs),
+    Merge(crate::pipeline::shard::MergeArgs),
     /// List the done, missing and damaged units of a sharded run and the shards to rerun.
-    Status(crate::experiment::shard::cli::StatusArgs),
+    Status(crate::pipeline::shard::StatusArgs),
     /// Run experiments on a Slurm cluster (job arrays of shards, then a merge).
     Slurm(crate::slurm::SlurmArgs),
     /// Measure render throughput per strategy and thread count.
@@ -65,7 +67,7 @@ pub struct RunArgs {
     #[command(flatten)]
     pub sweep: SweepArgs,
     #[command(flatten)]
-    pub shard: crate::experiment::shard::cli::ShardArgs,
+    pub shard: crate::pipeline::shard::ShardArgs,
 }
 
 #[derive(Args, Debug)]
@@ -81,7 +83,8 @@ pub struct ReproduceArgs {
 }
 
 fn run_files(files: &[PathBuf], a: &SweepArgs) -> Result<(), String> {
-    use crate::experiment::{events, run_and_report};
+    use crate::experiment::events;
+    use crate::pipeline::run_and_report;
     let opts = crate::experiment::args::options(a);
     let start = std::time::Instant::now();
     let mut failed = Vec::new();
@@ -132,7 +135,7 @@ fn cmd_run(a: &RunArgs) -> Result<(), String> {
         a.experiments.clone()
     };
     match a.shard.shard {
-        Some(s) => crate::experiment::shard::cli::cmd_run_shard(&files, &a.sweep, s, a.shard.stage),
+        Some(s) => crate::pipeline::shard::cmd_run_shard(&files, &a.sweep, s, a.shard.stage),
         None => run_files(&files, &a.sweep),
     }
 }
@@ -183,11 +186,11 @@ pub struct RenderArgs {
     #[arg(long, value_parser = crate::render::parse_threads)]
     pub threads: Option<usize>,
     /// Sampler (default: the scene's <sampler type>, mapped to the nearest directlab one).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = named::<crate::sampler::SamplerKind>())]
     pub sampler: Option<crate::sampler::SamplerKind>,
     /// Dimension allocation: a light or BSDF sample's numbers as one joint point, or padded
     /// 1D/2D draws (only the Sobol' samplers draw jointly).
-    #[arg(long, value_enum, default_value_t)]
+    #[arg(long, value_parser = named::<crate::sampler::DimAlloc>(), default_value_t)]
     pub dims: crate::sampler::DimAlloc,
     /// Output EXR (default: <scene name>.exr in the current directory); a PNG preview is
     /// written beside it.
@@ -204,10 +207,10 @@ pub struct RenderArgs {
     pub stats: Option<PathBuf>,
     /// `direct`: render the direct illumination of a scene whose integrator is a path tracer
     /// or Whitted's (refused without it); the image is the direct part only.
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = named::<crate::scene::loader::IntegratorMode>())]
     pub integrator: Option<crate::scene::loader::IntegratorMode>,
     #[command(flatten)]
-    pub strategy: StrategyOverrides,
+    pub strategy: StrategyArgs,
 }
 
 #[derive(serde::Serialize)]
@@ -272,13 +275,14 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
     let scene = crate::scene::open_with(&a.scene, &a.define, a.integrator)?;
     let strategy = a
         .strategy
+        .overrides()
         .apply(Strategy::from_desc(&scene.desc.integrator))?;
     let settings = RenderSettings {
         spp: a.spp.unwrap_or(scene.desc.sampler.sample_count),
         seed: a.seed.unwrap_or(scene.desc.sampler.seed),
         first_sample: 0,
         threads: a.threads,
-        progress: std::io::stderr().is_terminal(),
+        progress: crate::progress::tiles(std::io::stderr().is_terminal()),
         sampling: crate::sampler::Sampling {
             kind: a.sampler.unwrap_or(scene.desc.sampler.kind),
             dims: a.dims,
@@ -348,9 +352,9 @@ pub fn main() -> i32 {
                 .ok_or_else(|| "some sampling routines do not match their pdfs".to_string())
         }),
         Command::Extreme(a) => cmd_extreme(a),
-        Command::Plan(a) => crate::experiment::shard::cli::cmd_plan(a),
-        Command::Merge(a) => crate::experiment::shard::cli::cmd_merge(a),
-        Command::Status(a) => crate::experiment::shard::cli::cmd_status(a),
+        Command::Plan(a) => crate::pipeline::shard::cmd_plan(a),
+        Command::Merge(a) => crate::pipeline::shard::cmd_merge(a),
+        Command::Status(a) => crate::pipeline::shard::cmd_status(a),
         Command::Slurm(a) => crate::slurm::run(a),
         Command::Test(a) => crate::noritest::run(a).and_then(|ok| {
             ok.then_some(())

@@ -19,7 +19,7 @@ fn render_with(scene: &Scene, s: Strategy, spp: u32, seed: u64) -> RenderOutput 
             seed,
             first_sample: 0,
             threads: None,
-            progress: false,
+            progress: None,
             sampling: Default::default(),
         },
     )

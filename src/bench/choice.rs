@@ -10,12 +10,10 @@ use glam::Vec3;
 use std::hint::black_box;
 use std::time::Instant;
 
-const RULES: [EmitterSelection; 4] = [
-    EmitterSelection::Uniform,
-    EmitterSelection::Power,
-    EmitterSelection::Bvh,
-    EmitterSelection::Exhaustive,
-];
+/// Every registered emitter-choice rule.
+fn rules() -> Vec<EmitterSelection> {
+    crate::emitter::RULES.iter().map(|r| r.0).collect()
+}
 
 /// The choices timed per run: 2^20, or fewer where a choice visits every emitter (about
 /// 2^24 importance evaluations a run).
@@ -85,24 +83,28 @@ pub(super) fn section(a: &BenchArgs, rows: &mut Vec<Row>) -> Result<(), String> 
             build = build.min(start.elapsed().as_secs_f64() * 1e3);
             tree = Some(t);
         }
-        let selectors: Vec<EmitterSelector> = RULES
+        let rules = rules();
+        let selectors: Vec<EmitterSelector> = rules
             .iter()
             .map(|&r| match r {
                 EmitterSelection::Bvh => tree.clone().expect("built above"),
                 r => EmitterSelector::new(emitters, shapes, r),
             })
             .collect();
-        let mut best = vec![(f64::INFINITY, f64::INFINITY); RULES.len()];
+        let mut best = vec![(f64::INFINITY, f64::INFINITY); rules.len()];
         // The rules take turns, run by run, so that one slow spell of the machine does not
         // fall on one rule.
         for _ in 0..a.repeat {
-            for ((rule, sel), b) in RULES.iter().zip(&selectors).zip(&mut best) {
+            for ((rule, sel), b) in rules.iter().zip(&selectors).zip(&mut best) {
                 let (c, p) = run_ns(sel, choices(*rule, n));
                 *b = (b.0.min(c), b.1.min(p));
             }
         }
-        let (depth, bytes) = selectors[2].tree_stats().expect("the tree");
-        let line: Vec<String> = RULES
+        let (depth, bytes) = tree
+            .as_ref()
+            .and_then(EmitterSelector::tree_stats)
+            .expect("the tree");
+        let line: Vec<String> = rules
             .iter()
             .zip(&best)
             .map(|(r, (c, p))| format!("{} {c:.1}/{p:.1}", r.name()))
@@ -112,7 +114,7 @@ pub(super) fn section(a: &BenchArgs, rows: &mut Vec<Row>) -> Result<(), String> 
             line.join(", "),
             bytes as f64 / 1024.0
         );
-        for (r, (c, p)) in RULES.iter().zip(&best) {
+        for (r, (c, p)) in rules.iter().zip(&best) {
             for (what, v) in [("choice", c), ("pmf", p)] {
                 rows.push(Row {
                     section: "emitter_choice",

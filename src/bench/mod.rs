@@ -12,7 +12,7 @@ mod copies;
 mod load;
 mod raylimit;
 mod samplers;
-pub(crate) mod scaling;
+pub(crate) use crate::scene::scaling;
 mod sweeps;
 mod throughput;
 mod timing;

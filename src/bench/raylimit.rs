@@ -429,7 +429,7 @@ pub fn measure_interleaved(
         seed: MIX_SEED,
         first_sample: 0,
         threads: Some(1),
-        progress: false,
+        progress: None,
         sampling: Default::default(),
     };
     let bands: Vec<_> = (0..h)

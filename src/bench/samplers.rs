@@ -5,6 +5,7 @@
 
 use super::timing::sampler_throughputs;
 use super::{paired_ratio, power_mis, BenchArgs, Row};
+use crate::named::Named;
 use crate::sampler::SamplerKind;
 use crate::scene::Scene;
 
@@ -15,7 +16,7 @@ pub(super) fn section(
     threads: usize,
     rows: &mut Vec<Row>,
 ) {
-    let kinds = SamplerKind::ALL;
+    let kinds = SamplerKind::all();
     let timed = sampler_throughputs(scene, power_mis(), &kinds, a.spp, &[threads], a.repeat);
     let base = &timed[0][0];
     debug_assert_eq!(kinds[0], SamplerKind::Independent);

@@ -54,7 +54,7 @@ fn timed(scene: &Scene, strategy: Strategy, kind: SamplerKind, spp: u32, t: usiz
         seed: 1,
         first_sample: 0,
         threads: Some(t),
-        progress: false,
+        progress: None,
         sampling: Sampling {
             kind,
             ..Default::default()

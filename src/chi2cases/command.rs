@@ -42,7 +42,7 @@ pub struct Chi2Args {
     #[arg(long, default_value = "uniform")]
     pub emitter_selection: crate::emitter::EmitterSelection,
     /// The scene's light sampling.
-    #[arg(long, value_enum, default_value = "area")]
+    #[arg(long, value_parser = crate::choices::named::<crate::emitter::LightSampling>(), default_value = "area")]
     pub light_sampling: crate::emitter::LightSampling,
     /// Set a scene parameter declared with <default>: -D name=value (repeatable).
     #[arg(short = 'D', value_parser = crate::scene::loader::parse_define)]

@@ -114,27 +114,29 @@ pub const ALIAS_WEIGHTS: [f64; 8] = [1.0, 0.0, 3.0, 0.5, 10.0, 2.5, 1e-3, 7.0];
 
 fn emitter_choice(selection: EmitterSelection) -> Case {
     let scene = emitters::build(emitters::scene_lights());
-    let (label, weights): (&str, Vec<f64>) = match selection {
-        EmitterSelection::Uniform => ("uniform", vec![1.0; scene.emitters.len()]),
-        EmitterSelection::Power => (
-            "power",
-            scene
-                .emitters
-                .iter()
-                .map(|e| match e {
-                    // pi * area * luminance, area recomputed from the geometry.
-                    Emitter::Area(a) => {
-                        std::f64::consts::PI * shape_area(&scene, a) * luminance(a.radiance) as f64
-                    }
-                    Emitter::Point(p) => 4.0 * std::f64::consts::PI * luminance(p.intensity) as f64,
-                })
-                .collect(),
-        ),
-        other => unreachable!("{other}: the choice here is the same at every point"),
+    let label = selection.name();
+    let selector = EmitterSelector::new(&scene.emitters, &scene.shapes, selection);
+    // The expected weights from first principles where the rule has them; a newly
+    // registered rule is checked against its own pmf (consistency of sample and pmf).
+    let weights: Vec<f64> = match selection {
+        EmitterSelection::Uniform => vec![1.0; scene.emitters.len()],
+        EmitterSelection::Power => scene
+            .emitters
+            .iter()
+            .map(|e| match e {
+                // pi * area * luminance, area recomputed from the geometry.
+                Emitter::Area(a) => {
+                    std::f64::consts::PI * shape_area(&scene, a) * luminance(a.radiance) as f64
+                }
+                Emitter::Point(p) => 4.0 * std::f64::consts::PI * luminance(p.intensity) as f64,
+            })
+            .collect(),
+        _ => (0..scene.emitters.len())
+            .map(|i| selector.pmf(glam::Vec3::ZERO, glam::Vec3::ZERO, i) as f64)
+            .collect(),
     };
     let name = format!("discrete/emitter-choice-{label}");
     let pmf = normalised(&weights);
-    let selector = EmitterSelector::new(&scene.emitters, &scene.shapes, selection);
     Case::new(
         name.clone(),
         format!("EmitterSelector ({label}) over the five-light scene"),
@@ -259,7 +261,11 @@ fn point_choices() -> Vec<Case> {
         ("off-centre", Vec3::new(0.3, -0.2, 0.1), Vec3::ZERO),
     ];
     let mut out = Vec::new();
-    for selection in [EmitterSelection::Exhaustive, EmitterSelection::Bvh] {
+    let at_point = crate::emitter::RULES
+        .iter()
+        .map(|r| r.0)
+        .filter(|r| r.at_point());
+    for selection in at_point {
         for (view, p, n) in points {
             let scene = emitters::build(emitters::scene_lights());
             let selector = EmitterSelector::new(&scene.emitters, &scene.shapes, selection);
@@ -299,24 +305,27 @@ fn point_choices() -> Vec<Case> {
 pub fn cases() -> Vec<Case> {
     let pmf = normalised(&ALIAS_WEIGHTS);
     let table = AliasTable::new(&ALIAS_WEIGHTS).expect("positive weights");
-    vec![
-        Case::new(
-            "discrete/alias-table",
-            "Walker/Vose alias table over eight weights (one zero)",
-            move |cfg| {
-                discrete_test(
-                    "discrete/alias-table",
-                    &pmf,
-                    |r| table.sample(r.next_f32()),
-                    cfg,
-                )
-            },
-        ),
-        emitter_choice(EmitterSelection::Uniform),
-        emitter_choice(EmitterSelection::Power),
-        triangle_choice(),
-    ]
+    vec![Case::new(
+        "discrete/alias-table",
+        "Walker/Vose alias table over eight weights (one zero)",
+        move |cfg| {
+            discrete_test(
+                "discrete/alias-table",
+                &pmf,
+                |r| table.sample(r.next_f32()),
+                cfg,
+            )
+        },
+    )]
     .into_iter()
+    .chain(
+        // Every registered rule blind to the shading point; the others at points below.
+        crate::emitter::RULES
+            .iter()
+            .filter(|r| !r.0.at_point())
+            .map(|r| emitter_choice(r.0)),
+    )
+    .chain([triangle_choice()])
     .chain(point_choices())
     .chain(dielectric_lobes())
     .collect()

@@ -129,10 +129,7 @@ fn viewpoints(kind: &str) -> Vec<(&'static str, Vec3)> {
 type LightFn = fn() -> ShapeDesc;
 
 fn mode_name(m: LightSampling) -> &'static str {
-    match m {
-        LightSampling::Area => "area",
-        LightSampling::SolidAngle => "solid-angle",
-    }
+    crate::named::Named::name(m)
 }
 
 /// Tests a probe in a window fitted to its lights when they are small enough, else on the
@@ -207,7 +204,7 @@ pub fn scene_lights() -> Vec<ShapeDesc> {
 }
 
 pub fn cases() -> Vec<Case> {
-    let modes = [LightSampling::Area, LightSampling::SolidAngle];
+    let modes = <LightSampling as crate::named::Named>::all();
     let lights: [(&str, LightFn); 4] = [
         ("triangle", triangle),
         ("quad", quad),
@@ -217,7 +214,7 @@ pub fn cases() -> Vec<Case> {
     let mut out = Vec::new();
     for (kind, shape) in lights {
         let scene = build(vec![shape()]);
-        for mode in modes {
+        for &mode in &modes {
             for (view, p) in viewpoints(kind) {
                 let name = format!("emitter/{kind}-{}-{view}", mode_name(mode));
                 let about = format!("{kind} light sampled by {}, seen from {p}", mode_name(mode));
@@ -229,7 +226,7 @@ pub fn cases() -> Vec<Case> {
     let scene = build(scene_lights());
     for selection in [EmitterSelection::Uniform, EmitterSelection::Power] {
         let sel = selection.name();
-        for mode in modes {
+        for &mode in &modes {
             let name = format!("emitter/scene-{sel}-{}", mode_name(mode));
             let about = format!(
                 "five lights (one facing away) chosen {sel}, sampled by {}, from the origin",

@@ -9,15 +9,10 @@ use statrs::distribution::{ContinuousCDF, Normal};
 /// The chosen error of a row: MSE and relMSE corrected for the reference's noise, the
 /// others raw (NaN where the row lacks them).
 pub fn error_of(r: &Row, m: ErrorMetric) -> f64 {
-    let nan = f64::NAN;
     match m {
         ErrorMetric::Mse => r.mse_corrected,
         ErrorMetric::Relmse => r.relmse_corrected,
-        ErrorMetric::TrimmedRelmse => r.trimmed_relmse.unwrap_or(nan),
-        ErrorMetric::Mape => r.mape.unwrap_or(nan),
-        ErrorMetric::Smape => r.smape.unwrap_or(nan),
-        ErrorMetric::Ssim => r.ssim_error.unwrap_or(nan),
-        ErrorMetric::Flip => r.flip.unwrap_or(nan),
+        m => (m.def().expect("registered").value)(r).unwrap_or(f64::NAN),
     }
 }
 
@@ -33,15 +28,7 @@ pub fn predicted_of(r: &Row, m: ErrorMetric) -> f64 {
 
 /// Short name for captions; figure titles state epsilon.
 pub fn metric_short(m: ErrorMetric) -> &'static str {
-    match m {
-        ErrorMetric::Mse => "MSE",
-        ErrorMetric::Relmse => "relMSE",
-        ErrorMetric::TrimmedRelmse => "trimmed relMSE",
-        ErrorMetric::Mape => "MAPE",
-        ErrorMetric::Smape => "SMAPE",
-        ErrorMetric::Ssim => "1-SSIM",
-        ErrorMetric::Flip => "FLIP",
-    }
+    m.short()
 }
 
 /// The metric with what defines it: epsilon, trimming, tone mapping (`exposure`).
@@ -51,16 +38,7 @@ pub fn metric_name(m: ErrorMetric, eps: f64) -> String {
 
 /// [`metric_name`] with MAPE's epsilon and the tone mapping's exposure.
 pub fn metric_label(m: ErrorMetric, eps: f64, mape_eps: f64, exposure: f64) -> String {
-    let tm = format!("sRGB at exposure {exposure}, clamped");
-    match m {
-        ErrorMetric::Mse => "MSE".into(),
-        ErrorMetric::Relmse => format!("relMSE (eps {eps})"),
-        ErrorMetric::TrimmedRelmse => format!("trimmed relMSE (eps {eps}, largest 0.1 % dropped)"),
-        ErrorMetric::Mape => format!("MAPE (eps {mape_eps})"),
-        ErrorMetric::Smape => format!("SMAPE (eps {mape_eps}, no factor 2)"),
-        ErrorMetric::Ssim => format!("1-SSIM ({tm})"),
-        ErrorMetric::Flip => format!("FLIP ({tm}, 67 ppd)"),
-    }
+    m.label(eps, mape_eps, exposure)
 }
 
 /// One point of a convergence curve: the seeds' errors at one spp.

@@ -28,7 +28,7 @@ pub struct SweepArgs {
     /// `none`: HTML reports without embedded images (no image viewer; figures linked beside
     /// the page), for small pages.
     #[arg(long, value_enum, default_value_t)]
-    pub viewer: crate::report::html::Viewer,
+    pub viewer: Viewer,
 }
 
 /// The runner's options from the command line's (and `--json` switched on for the
@@ -41,4 +41,14 @@ pub fn options(a: &SweepArgs) -> RunOptions {
         fresh_reference: a.fresh_reference,
         viewer: a.viewer,
     }
+}
+
+/// What the HTML pages carry (`--viewer`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Viewer {
+    /// The image viewer with embedded HDR images, plots inline, small figures embedded.
+    #[default]
+    Full,
+    /// No embedded images: no image viewer, every figure linked beside the page.
+    None,
 }

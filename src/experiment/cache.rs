@@ -1,10 +1,9 @@
 //! Reference images: rendered once at high spp and cached under a key that changes whenever
 //! anything that could change the image changes: the scene file and every file it references
 //! (meshes), the `-D` overrides, the reference's spp, seed and estimator, the crate version and
-//! a hash of the renderer's source (`build.rs`).
-//!
-//! The key does not see dependency upgrades (a new glam or obvhs could round differently);
-//! `--fresh-reference` re-renders after such a change.
+//! the renderer crate's hash ([`RENDERER_HASH`]: every source file of `crates/render` and the
+//! locked versions of the crates it depends on). A reference cached under another key is
+//! re-rendered, and the run and its report say why ([`why_not_cached`]).
 
 use crate::film::{self, Image};
 use crate::integrator::Strategy;
@@ -12,40 +11,9 @@ use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// Hash of the renderer's source files, computed by `build.rs`.
-pub const RENDERER_HASH: &str = env!("DIRECTLAB_RENDERER_HASH");
+pub use crate::RENDERER_HASH;
 
-/// FNV-1a, 64 bit: stable across Rust versions and platforms, unlike `DefaultHasher`.
-pub struct Fnv(u64);
-
-impl Fnv {
-    pub fn new() -> Self {
-        Fnv(0xcbf2_9ce4_8422_2325)
-    }
-
-    pub fn bytes(&mut self, b: &[u8]) -> &mut Self {
-        for &x in b {
-            self.0 ^= x as u64;
-            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-        self
-    }
-
-    /// Length-prefixed, so ("ab", "c") and ("a", "bc") hash differently.
-    pub fn field(&mut self, b: &[u8]) -> &mut Self {
-        self.bytes(&(b.len() as u64).to_le_bytes()).bytes(b)
-    }
-
-    pub fn hex(&self) -> String {
-        format!("{:016x}", self.0)
-    }
-}
-
-impl Default for Fnv {
-    fn default() -> Self {
-        Self::new()
-    }
-}
+pub use crate::fnv::Fnv;
 
 /// The scene file and the files it names through `filename` parameters (after `$name`
 /// substitution with the defines), in document order.
@@ -123,6 +91,46 @@ pub struct Reference {
     pub info: ReferenceInfo,
     /// True if it came from the cache.
     pub cached: bool,
+    /// Why it was rendered rather than read from the cache (None when cached).
+    pub why_rendered: Option<String>,
+}
+
+/// Why the cache in `dir` has no reference under `key`: the references it holds under other
+/// keys were made by another renderer build ("renderer changed", with both hashes), or by this
+/// one for other inputs (scene, meshes, defines or reference settings), or there are none.
+pub fn why_not_cached(dir: &Path, key: &str) -> String {
+    let mut others: Vec<ReferenceInfo> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let k = name.strip_prefix("reference-")?.strip_suffix(".json")?;
+            if k == key {
+                return None;
+            }
+            serde_json::from_str(&std::fs::read_to_string(e.path()).ok()?).ok()
+        })
+        .collect();
+    others.sort_by(|a, b| a.key.cmp(&b.key));
+    match others.iter().find(|i| i.renderer != RENDERER_HASH) {
+        Some(old) => format!(
+            "renderer changed: the cached reference {} was rendered by renderer {}, this \
+             build is renderer {RENDERER_HASH}",
+            old.key,
+            if old.renderer.is_empty() {
+                "(unknown)"
+            } else {
+                &old.renderer
+            }
+        ),
+        None if !others.is_empty() => format!(
+            "the scene, its meshes, the defines or the reference settings changed (cached \
+             reference {} has another key, same renderer)",
+            others[0].key
+        ),
+        None => "no reference in the cache yet".into(),
+    }
 }
 
 /// Noise floors of a reference with per-pixel variance-of-mean `var`.
@@ -177,6 +185,7 @@ pub fn cached(dir: &Path, key: &str, eps: f64) -> Option<Reference> {
         variance,
         info,
         cached: true,
+        why_rendered: None,
     })
 }
 
@@ -196,8 +205,13 @@ pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, St
             return Ok(r);
         }
     }
+    let why = if req.fresh {
+        "--fresh-reference".to_string()
+    } else {
+        why_not_cached(dir, &req.key)
+    };
     eprintln!(
-        "rendering the reference ({} at {} spp); it is cached in {} for later runs",
+        "rendering the reference ({} at {} spp; {why}); it is cached in {} for later runs",
         req.strategy.label(),
         req.spp,
         dir.display()
@@ -214,7 +228,7 @@ pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, St
             key: &req.key,
         },
     )?;
-    store(
+    let mut r = store(
         dir,
         &Identity {
             key: &req.key,
@@ -224,12 +238,15 @@ pub fn get_or_render(dir: &Path, req: &ReferenceRequest) -> Result<Reference, St
             relmse_epsilon: req.relmse_epsilon,
         },
         &acc,
-    )
+    )?;
+    r.why_rendered = Some(why);
+    Ok(r)
 }
 
 /// Stores the merged statistics `acc` of reference `id` in the cache (the JSON last: its
 /// presence marks a complete entry) and removes references of other keys.
 pub fn store(dir: &Path, id: &Identity, acc: &super::chunks::Accum) -> Result<Reference, String> {
+    let why = why_not_cached(dir, id.key);
     let (mut mean, mut variance) = acc.images();
     // The EXR holds f32: measure against what is stored, so a run that renders the
     // reference and one that reads it from the cache (or from merged shards) agree exactly.
@@ -269,6 +286,7 @@ pub fn store(dir: &Path, id: &Identity, acc: &super::chunks::Accum) -> Result<Re
         variance,
         info,
         cached: false,
+        why_rendered: Some(why),
     })
 }
 
@@ -301,6 +319,7 @@ pub fn constant(width: u32, height: u32, value: f64, key: String) -> Reference {
             relmse_epsilon: 0.0,
         },
         cached: true,
+        why_rendered: None,
     }
 }
 

@@ -246,7 +246,7 @@ pub fn render_chunk(
             seed,
             first_sample: first,
             threads,
-            progress,
+            progress: crate::progress::tiles(progress),
             // References draw independent samples: their chunks merge as independent
             // estimates whatever the sweep's samplers.
             sampling: Default::default(),
@@ -384,7 +384,7 @@ mod tests {
                 seed: 3,
                 first_sample: 0,
                 threads: Some(1),
-                progress: false,
+                progress: None,
                 sampling: Default::default(),
             },
         ));

@@ -2,10 +2,11 @@
 //! reference's noise), the errors its own variance predicts, z^2, image mean and variance.
 
 use super::cache::Reference;
+use super::metric::{Eps, Inputs, MetricDef, EXTRA_METRICS};
 use super::plan::Job;
 use super::results::Row;
 use super::schema::{ErrorMetric, Experiment};
-use crate::metrics::{self, flip, pointwise, ssim};
+use crate::metrics;
 use crate::render::RenderOutput;
 
 /// What a row measures beside MSE and relMSE.
@@ -32,8 +33,11 @@ impl Extra {
         format!("{}|{}|{}", names.join(","), self.mape_eps, self.exposure)
     }
 
-    fn has(&self, m: ErrorMetric) -> bool {
-        self.report.contains(&m)
+    /// The registered metrics the experiment reports.
+    fn chosen(&self) -> impl Iterator<Item = &'static MetricDef> + '_ {
+        EXTRA_METRICS
+            .iter()
+            .filter(|d| self.report.contains(&d.metric))
     }
 }
 
@@ -85,7 +89,7 @@ pub(crate) fn measure(
         .zip(&r.mean.data)
         .map(|(x, m)| (0..3).map(|c| (x[c] - m[c]).powi(2)).sum())
         .collect();
-    Row {
+    let mut row = Row {
         context: context.to_string(),
         case: String::new(),
         strategy: job.method.label(),
@@ -117,28 +121,29 @@ pub(crate) fn measure(
         z: None,
         max_sample: None,
         top_share: Some(crate::stats::top_share(pixel_err)),
-        trimmed_relmse: extra
-            .has(ErrorMetric::TrimmedRelmse)
-            .then(|| pointwise::trimmed_rel_mse(&out.mean, &r.mean, eps, pointwise::TRIM)),
-        mape: extra
-            .has(ErrorMetric::Mape)
-            .then(|| pointwise::mape(&out.mean, &r.mean, extra.mape_eps)),
-        smape: extra
-            .has(ErrorMetric::Smape)
-            .then(|| pointwise::smape(&out.mean, &r.mean, extra.mape_eps)),
-        mape_eps: (extra.has(ErrorMetric::Mape) || extra.has(ErrorMetric::Smape))
+        trimmed_relmse: None,
+        mape: None,
+        smape: None,
+        ssim_error: None,
+        flip: None,
+        mape_eps: extra
+            .chosen()
+            .any(|d| d.eps == Eps::Mape)
             .then_some(extra.mape_eps),
-        ssim_error: if extra.has(ErrorMetric::Ssim) {
-            let tm = |i: &crate::film::Image| crate::film::to_srgb_unit(i, extra.exposure);
-            let (w, h) = (out.mean.width as usize, out.mean.height as usize);
-            ssim::ssim(&tm(&out.mean), &tm(&r.mean), w, h).map(|s| 1.0 - s)
-        } else {
-            None
-        },
-        flip: extra
-            .has(ErrorMetric::Flip)
-            .then(|| flip::flip(&out.mean, &r.mean, extra.exposure)),
-        exposure: (extra.has(ErrorMetric::Ssim) || extra.has(ErrorMetric::Flip))
+        exposure: extra
+            .chosen()
+            .any(|d| d.tone_mapped)
             .then_some(extra.exposure),
+    };
+    let inputs = Inputs {
+        img: &out.mean,
+        reference: &r.mean,
+        relmse_eps: eps,
+        mape_eps: extra.mape_eps,
+        exposure: extra.exposure,
+    };
+    for d in extra.chosen() {
+        (d.set)(&mut row, (d.compute)(&inputs));
     }
+    row
 }

@@ -3,6 +3,7 @@
 //! with the independent sampler.
 
 use crate::integrator::Strategy;
+use crate::named::Named;
 use crate::sampler::{DimAlloc, SamplerKind, Sampling};
 use serde::Deserialize;
 use std::fmt;
@@ -23,16 +24,7 @@ impl SamplerSpec {
             Some((n, d)) => (n, Some(d)),
             None => (s, None),
         };
-        let kind = SamplerKind::ALL
-            .into_iter()
-            .find(|k| k.name() == name)
-            .ok_or_else(|| {
-                let names: Vec<_> = SamplerKind::ALL.iter().map(|k| k.name()).collect();
-                format!(
-                    "unknown sampler '{name}' (expected one of {})",
-                    names.join(", ")
-                )
-            })?;
+        let kind = SamplerKind::from_name(name)?;
         let dims = match dims {
             None => DimAlloc::Joint,
             Some(d) => {
@@ -43,12 +35,7 @@ impl SamplerSpec {
                         kind.name()
                     ));
                 }
-                [DimAlloc::Joint, DimAlloc::Padded]
-                    .into_iter()
-                    .find(|a| a.name() == d)
-                    .ok_or_else(|| {
-                        format!("sampler '{s}': unknown dimension allocation '{d}' (expected joint or padded)")
-                    })?
+                DimAlloc::from_name(d).map_err(|e| format!("sampler '{s}': {e}"))?
             }
         };
         Ok(SamplerSpec { kind, dims })
@@ -150,7 +137,7 @@ mod tests {
         for (bad, says) in [
             (
                 "halton",
-                "unknown sampler 'halton' (expected one of independent",
+                "unknown sampler 'halton': expected one of independent",
             ),
             ("sobol:diagonal", "unknown dimension allocation 'diagonal'"),
             ("stratified:padded", "takes no dimension allocation"),

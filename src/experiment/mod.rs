@@ -1,5 +1,7 @@
 //! The experiment runner: sweeps of (strategy, spp, seed) against a cached reference, with
-//! resumable results, left-out analysis, figures and a report per experiment.
+//! resumable results, left-out analysis and figures. It produces results (rows, images,
+//! figures, metadata in an [`Outcome`]) and never calls the report writer: `report/` reads
+//! what it produced, and `pipeline/` runs one after the other.
 
 pub mod analysis;
 pub mod args;
@@ -11,6 +13,7 @@ pub mod figures;
 pub mod leftout;
 mod measure;
 pub mod method;
+pub mod metric;
 pub mod plan;
 pub mod probe;
 pub mod resolve;
@@ -24,51 +27,6 @@ pub use resolve::load;
 pub use runner::{run_experiment, Outcome, RunOptions};
 pub use schema::Resolved;
 use std::path::{Path, PathBuf};
-
-/// Runs one experiment file and writes its figures and report; prints the mean check (image
-/// sweeps) or the table's summary (probe mode).
-pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(), String> {
-    let exp = load(file, quick)?;
-    if exp.exp.probe.is_some() {
-        return probe::run_and_report(exp, opts);
-    }
-    report_outcome(&run_experiment(exp, opts)?, opts.viewer)
-}
-
-/// Writes the figures and report of a finished sweep and prints its summary.
-pub fn report_outcome(o: &Outcome, viewer: crate::report::html::Viewer) -> Result<(), String> {
-    results::write_long(&o.dir.join("metrics.csv"), &o.rows)?;
-    events::write_jsonl(&o.dir.join("results.jsonl"), &o.rows)?;
-    let (series, mut figs) = figures::charts(o)?;
-    figs.extend(figures::images(o)?);
-    crate::report::write_experiment(o, &series, &figs, viewer)?;
-    for l in crate::report::mean_check_lines(o) {
-        events::say(&format!("{}: {l}", o.exp.name));
-    }
-    let index = o.dir.join("index.md");
-    events::say(&format!(
-        "{}: {} runs ({} rendered now) in {:.1} s -> {}",
-        o.exp.name,
-        o.rows.len(),
-        o.rendered,
-        o.seconds,
-        index.display()
-    ));
-    events::emit(
-        "report_written",
-        serde_json::json!({
-            "experiment": o.exp.name,
-            "index": index,
-            "results_csv": o.dir.join("results.csv"),
-            "results_jsonl": o.dir.join("results.jsonl"),
-            "metrics_csv": o.dir.join("metrics.csv"),
-            "runs": o.rows.len(),
-            "rendered": o.rendered,
-            "seconds": o.seconds,
-        }),
-    );
-    Ok(())
-}
 
 /// The `experiments/` folder: in the working directory, else in the source tree this binary
 /// was built from (so `cargo run -- reproduce` works from anywhere in a clone).

@@ -190,6 +190,7 @@ struct MetricRow<'a> {
 /// `metrics.csv`: every run's every measured metric, one per row, each row naming the
 /// metric, its epsilon and its tone mapping.
 pub fn write_long(path: &Path, rows: &[Row]) -> Result<(), String> {
+    use super::metric::Eps;
     use super::schema::ErrorMetric as M;
     write_atomic(path, |tmp| {
         let mut w = csv::Writer::from_path(tmp).map_err(|e| e.to_string())?;
@@ -198,7 +199,7 @@ pub fn write_long(path: &Path, rows: &[Row]) -> Result<(), String> {
                 Some(x) => format!("exposure {x}; clamp to [0 1]; sRGB"),
                 None => String::new(),
             };
-            let values = [
+            let mut values = vec![
                 (M::Mse, Some(r.mse), None, String::from("linear")),
                 (
                     M::Relmse,
@@ -206,17 +207,20 @@ pub fn write_long(path: &Path, rows: &[Row]) -> Result<(), String> {
                     Some(r.relmse_eps),
                     "linear".into(),
                 ),
-                (
-                    M::TrimmedRelmse,
-                    r.trimmed_relmse,
-                    Some(r.relmse_eps),
-                    "linear".into(),
-                ),
-                (M::Mape, r.mape, r.mape_eps, "linear".into()),
-                (M::Smape, r.smape, r.mape_eps, "linear".into()),
-                (M::Ssim, r.ssim_error, None, tm(r.exposure)),
-                (M::Flip, r.flip, None, tm(r.exposure)),
             ];
+            for d in super::metric::EXTRA_METRICS {
+                let epsilon = match d.eps {
+                    Eps::None => None,
+                    Eps::Relmse => Some(r.relmse_eps),
+                    Eps::Mape => r.mape_eps,
+                };
+                let tone = if d.tone_mapped {
+                    tm(r.exposure)
+                } else {
+                    "linear".into()
+                };
+                values.push((d.metric, (d.value)(r), epsilon, tone));
+            }
             for (m, v, epsilon, tone_mapping) in values {
                 let Some(value) = v else { continue };
                 w.serialize(MetricRow {
@@ -227,10 +231,7 @@ pub fn write_long(path: &Path, rows: &[Row]) -> Result<(), String> {
                     budget_s: r.budget_s,
                     spp: r.spp,
                     seed: r.seed,
-                    metric: match m {
-                        M::Ssim => "1-ssim",
-                        _ => m.slug(),
-                    },
+                    metric: m.long(),
                     epsilon,
                     tone_mapping,
                     value,

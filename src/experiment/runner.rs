@@ -28,7 +28,7 @@ pub struct RunOptions {
     /// Re-render the reference even if a cached one matches.
     pub fresh_reference: bool,
     /// What the HTML reports carry.
-    pub viewer: crate::report::html::Viewer,
+    pub viewer: super::args::Viewer,
 }
 
 /// Everything the figures and the report need.
@@ -77,7 +77,7 @@ pub(crate) fn render_job(ctx: &Ctx, job: &Job) -> Result<(Row, RenderOutput), St
         seed: job.seed,
         first_sample: 0,
         threads: ctx.threads,
-        progress: false,
+        progress: None,
         sampling: job.method.sampler.sampling(),
     };
     let cam = &ctx.scene.camera;
@@ -127,6 +127,7 @@ pub(crate) fn print_reference(name: &str, reference: &Reference) {
             "strategy": ri.strategy,
             "spp": ri.spp,
             "cached": reference.cached,
+            "why_rendered": reference.why_rendered,
             "seconds": ri.seconds,
             "mse_floor": ri.mse_floor,
             "relmse_floor": ri.relmse_floor,

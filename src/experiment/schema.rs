@@ -141,54 +141,7 @@ impl Default for ReferenceSpec {
     }
 }
 
-/// An error of a render against the reference. MSE and relMSE are corrected for the
-/// reference's noise and have predicted values (they can be `primary`); the others are
-/// reported beside them (`report`), raw.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum ErrorMetric {
-    Mse,
-    Relmse,
-    /// relMSE without its largest 0.1 % of terms.
-    TrimmedRelmse,
-    /// mean |x - r| / (|r| + eps).
-    Mape,
-    /// mean |x - r| / (|x| + |r| + eps), without a factor 2.
-    Smape,
-    /// 1 - SSIM on tone-mapped sRGB.
-    Ssim,
-    /// Mean FLIP on tone-mapped 8-bit sRGB.
-    Flip,
-}
-
-impl ErrorMetric {
-    /// Every metric beside MSE and relMSE, the default of `report`.
-    pub const EXTRA: [ErrorMetric; 5] = [
-        ErrorMetric::TrimmedRelmse,
-        ErrorMetric::Mape,
-        ErrorMetric::Smape,
-        ErrorMetric::Ssim,
-        ErrorMetric::Flip,
-    ];
-
-    /// Its name in experiment files and file names.
-    pub fn slug(self) -> &'static str {
-        match self {
-            ErrorMetric::Mse => "mse",
-            ErrorMetric::Relmse => "relmse",
-            ErrorMetric::TrimmedRelmse => "trimmed-relmse",
-            ErrorMetric::Mape => "mape",
-            ErrorMetric::Smape => "smape",
-            ErrorMetric::Ssim => "ssim",
-            ErrorMetric::Flip => "flip",
-        }
-    }
-
-    /// Whether it is measured on tone-mapped images (then the exposure is part of it).
-    pub fn tone_mapped(self) -> bool {
-        matches!(self, ErrorMetric::Ssim | ErrorMetric::Flip)
-    }
-}
+pub use super::metric::ErrorMetric;
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -209,7 +162,7 @@ pub struct MetricsSpec {
 }
 
 fn default_report() -> Vec<ErrorMetric> {
-    ErrorMetric::EXTRA.to_vec()
+    ErrorMetric::extra()
 }
 
 fn default_eps() -> f64 {

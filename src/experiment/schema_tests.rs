@@ -259,7 +259,7 @@ fn image_sweeps_take_one_scene_and_a_rendered_or_constant_reference() {
 #[test]
 fn metrics_report_defaults_to_every_extra_and_checks_its_choices() {
     let r = resolve(parse(EXAMPLE, &file()).unwrap(), &file(), false).unwrap();
-    assert_eq!(r.exp.metrics.report, ErrorMetric::EXTRA.to_vec());
+    assert_eq!(r.exp.metrics.report, ErrorMetric::extra());
     assert_eq!(r.exp.metrics.mape_epsilon, 0.01);
     let some = EXAMPLE.replace(
         "relmse_epsilon = 0.001",

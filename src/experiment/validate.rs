@@ -119,8 +119,10 @@ pub(crate) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
         return fail(format!(
             "metrics.report lists \"{}\", which is always reported; list only {}",
             x.slug(),
-            ErrorMetric::EXTRA
+            ErrorMetric::extra()
+                .iter()
                 .map(|e| format!("\"{}\"", e.slug()))
+                .collect::<Vec<_>>()
                 .join(", ")
         ));
     }

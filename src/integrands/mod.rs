@@ -10,7 +10,9 @@
 pub mod pixel;
 pub mod report;
 
-use crate::sampler::{DimAlloc, LanesVisitor, SamplerConfig, SamplerKind, SamplerLanes, Sampling};
+use crate::sampler::{
+    DimAlloc, LanesVisitor, PointKind, SamplerConfig, SamplerKind, SamplerLanes, Sampling,
+};
 use crate::stats::slope::{bootstrap_slope, fit_slope, SeedErrors, BOOTSTRAP_DRAWS};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -103,23 +105,24 @@ impl Integrand {
     /// counts (powers of two; of four for jittered), as summarised in REFERENCE.md section
     /// 9. None where the paper has no such sampler (a digital shift alone).
     pub fn published(self, kind: SamplerKind) -> Option<f64> {
-        match kind {
-            SamplerKind::Independent => Some(-0.5),
-            SamplerKind::Stratified => Some(if self.smooth() { -1.0 } else { -0.75 }),
-            SamplerKind::Sobol | SamplerKind::ZSobol => Some(match self {
+        match kind.points() {
+            PointKind::Random => Some(-0.5),
+            PointKind::Jittered => Some(if self.smooth() { -1.0 } else { -0.75 }),
+            PointKind::ScrambledNet => Some(match self {
                 Integrand::QuarterDisk | Integrand::Triangle => -0.75,
                 Integrand::Step => -1.0,
                 Integrand::Gaussian | Integrand::Bilinear => -1.5,
             }),
-            SamplerKind::SobolXor => None,
+            PointKind::ShiftedNet => None,
         }
     }
 }
 
 /// Whether `n` is a count where the sampler's structure is complete: a power of four for
-/// the stratified sampler (a square grid), a power of two for the others.
+/// jittered strata (a square grid), a power of two for the others.
 pub fn complete_count(kind: SamplerKind, n: u32) -> bool {
-    n.is_power_of_two() && (kind != SamplerKind::Stratified || n.trailing_zeros().is_multiple_of(2))
+    n.is_power_of_two()
+        && (kind.points() != PointKind::Jittered || n.trailing_zeros().is_multiple_of(2))
 }
 
 /// Powers of two from 16 to `max_n`, and off-grid counts between them: 2^(k + 1/2)

@@ -11,6 +11,7 @@
 use super::Cell;
 use crate::analytic::polygon_irradiance;
 use crate::integrator::{LaneKernel, LaneScratch, Strategy};
+use crate::named::Named;
 use crate::render::{render_rows, RenderSettings};
 use crate::sampler::{DimAlloc, SamplerKind, Sampling};
 use crate::scene::Scene;
@@ -142,7 +143,7 @@ pub fn strategies(scene: &Scene) -> Vec<(&'static str, Strategy)> {
 
 /// The samplers compared: every kind with joint groups, and Sobol' padded.
 pub fn samplings() -> Vec<Sampling> {
-    SamplerKind::ALL
+    SamplerKind::all()
         .iter()
         .map(|&kind| Sampling {
             kind,
@@ -201,7 +202,7 @@ pub fn measure(counts: &[u32], seeds: u64) -> Result<Vec<PixelCell>, String> {
                     seed,
                     first_sample: 0,
                     threads: Some(1),
-                    progress: false,
+                    progress: None,
                     sampling,
                 };
                 settings.sampler_config((1, 1))?;
@@ -247,7 +248,7 @@ mod tests {
                         seed,
                         first_sample: 0,
                         threads: Some(1),
-                        progress: false,
+                        progress: None,
                         sampling: Sampling::default(),
                     };
                     w.push(render_rows(&kernel, 0..1, &settings, &mut scratch));

@@ -4,6 +4,7 @@
 
 use super::pixel::{self, PixelCell};
 use super::{complete_count, measure, sample_counts, slope, Cell, Integrand, Slope};
+use crate::named::Named;
 use crate::output::write_atomic;
 use crate::plot::{write_chart, Line, LogLogChart};
 use crate::sampler::SamplerKind;
@@ -19,7 +20,7 @@ pub struct IntegrandsArgs {
     #[arg(long, default_value_t = 4096)]
     pub max_n: u32,
     /// Samplers to compare, comma-separated (default: all).
-    #[arg(long, value_enum, value_delimiter = ',')]
+    #[arg(long, value_parser = crate::choices::named::<SamplerKind>(), value_delimiter = ',')]
     pub samplers: Vec<SamplerKind>,
     /// Reports folder; the report is written to `<out>/integrands/`.
     #[arg(long, default_value = "reports")]
@@ -76,7 +77,7 @@ pub fn run(a: &IntegrandsArgs) -> Result<PathBuf, String> {
         ));
     }
     let samplers: Vec<SamplerKind> = if a.samplers.is_empty() {
-        SamplerKind::ALL.to_vec()
+        SamplerKind::all()
     } else {
         a.samplers.clone()
     };

@@ -1,4 +1,5 @@
 use super::*;
+use crate::named::Named;
 
 /// The closed forms against a midpoint rule on a 4000 x 4000 grid (edges cost it about
 /// one cell row: 1e-3 is loose enough for them and tight for a wrong constant).
@@ -43,7 +44,7 @@ fn counts_are_powers_of_two_and_off_grid() {
 #[test]
 fn rates_at_reduced_size() {
     let counts = sample_counts(1024);
-    let cells = measure(&SamplerKind::ALL, &counts, 64).unwrap();
+    let cells = measure(&SamplerKind::all(), &counts, 64).unwrap();
     let get = |k: SamplerKind, f: Integrand| {
         let i = Integrand::ALL.iter().position(|&g| g == f).unwrap();
         let mine: Vec<&Cell> = cells.iter().filter(|c| c.sampler == k).collect();

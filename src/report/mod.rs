@@ -72,10 +72,9 @@ fn settings(md: &mut String, o: &Outcome) {
             ri.spp,
             ri.seed,
             ri.seconds,
-            if o.reference.cached {
-                "from the cache"
-            } else {
-                "rendered in this run"
+            match &o.reference.why_rendered {
+                None => "from the cache".to_string(),
+                Some(why) => format!("rendered in this run: {why}"),
             },
             ri.non_finite_samples,
             ri.key,

@@ -46,7 +46,7 @@ pub fn measure(
         seed,
         first_sample: 0,
         threads,
-        progress: false,
+        progress: None,
         sampling: Default::default(),
     };
     let out = render(scene, s, &settings);

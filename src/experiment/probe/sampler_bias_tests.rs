@@ -6,6 +6,7 @@
 use super::closed_form::evaluate;
 use crate::experiment::cases::ClosedForm;
 use crate::integrator::Strategy;
+use crate::named::Named;
 use crate::render::{render, RenderSettings};
 use crate::sampler::{DimAlloc, SamplerKind, Sampling};
 use crate::stats::{one_sample, sidak, Welford};
@@ -26,17 +27,20 @@ fn every_sampler_and_strategy_is_unbiased_against_lambert() {
         std::fs::write(&path, probe_scene(at, half)).unwrap();
         path
     });
-    let samplers: Vec<Sampling> = SamplerKind::ALL
+    // Every registered sampler, and padded as well as joint where the allocation matters.
+    let samplers: Vec<Sampling> = SamplerKind::all()
         .into_iter()
-        .map(|kind| Sampling {
-            kind,
-            ..Default::default()
+        .flat_map(|kind| {
+            let padded = kind.allocates_dims().then_some(DimAlloc::Padded);
+            [Some(DimAlloc::Joint), padded]
+                .into_iter()
+                .flatten()
+                .map(move |dims| Sampling {
+                    kind,
+                    dims,
+                    run_samples: None,
+                })
         })
-        .chain([Sampling {
-            kind: SamplerKind::Sobol,
-            dims: DimAlloc::Padded,
-            run_samples: None,
-        }])
         .collect();
     let strategies = Strategy::combinations();
     let spps = [16u32, 12];
@@ -60,7 +64,7 @@ fn every_sampler_and_strategy_is_unbiased_against_lambert() {
                                 seed,
                                 first_sample: 0,
                                 threads: Some(1),
-                                progress: false,
+                                progress: None,
                                 sampling: *sampling,
                             },
                         );

@@ -73,7 +73,7 @@ mod tests {
             seed: 9,
             first_sample: 0,
             threads: Some(1),
-            progress: false,
+            progress: None,
             sampling: Default::default(),
         };
         let img = render(&scene, s, &settings);

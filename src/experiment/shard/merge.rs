@@ -113,7 +113,7 @@ pub fn merge(
     quick: bool,
     opts: &RunOptions,
     only: Option<Stage>,
-) -> Result<(), String> {
+) -> Result<Option<Merged>, String> {
     let start = Instant::now();
     let p = open(file, quick, opts, true, None)?;
     if only.is_some_and(|s| s != Stage::Reference) {
@@ -122,7 +122,7 @@ pub fn merge(
     let reference = merge_reference(&p)?;
     print_reference(&p.s.exp.name, &reference);
     if only == Some(Stage::Reference) {
-        return Ok(());
+        return Ok(None);
     }
     let mut units = stage_rows(&p, Stage::Sweep)?;
     if p.plan.of_stage(Stage::Timed).next().is_some() {
@@ -155,8 +155,21 @@ pub fn merge(
     let results = Results { rows, dropped: 0 };
     results.save(&csv)?;
     let marker = p.merged_marker();
-    let o = crate::experiment::Outcome::of(p.s, reference, results.rows, start);
-    crate::experiment::report_outcome(&o, opts.viewer)?;
-    std::fs::write(&marker, "merged\n").map_err(|e| format!("{}: {e}", marker.display()))?;
-    Ok(())
+    let outcome = crate::experiment::Outcome::of(p.s, reference, results.rows, start);
+    Ok(Some(Merged { outcome, marker }))
+}
+
+/// A merged sweep: its outcome, to be reported, and the marker that says it is merged.
+pub struct Merged {
+    pub outcome: crate::experiment::Outcome,
+    marker: std::path::PathBuf,
+}
+
+impl Merged {
+    /// Marks the experiment merged: written once its report is, so that an interrupted
+    /// merge is merged again.
+    pub fn mark(&self) -> Result<(), String> {
+        std::fs::write(&self.marker, "merged\n")
+            .map_err(|e| format!("{}: {e}", self.marker.display()))
+    }
 }

@@ -4,7 +4,6 @@
 //! one-machine run's. [`status`] says what is done and what is missing; [`cli`] holds the
 //! commands.
 
-pub mod cli;
 pub mod merge;
 pub mod run;
 pub mod status;

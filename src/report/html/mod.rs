@@ -14,15 +14,7 @@ use std::path::Path;
 
 const DOC: &str = include_str!("doc.js");
 
-/// What the HTML pages carry (`--viewer`).
-#[derive(clap::ValueEnum, Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Viewer {
-    /// The image viewer with embedded HDR images, plots inline, small figures embedded.
-    #[default]
-    Full,
-    /// No embedded images: no image viewer, every figure linked beside the page.
-    None,
-}
+pub use crate::experiment::args::Viewer;
 
 impl Viewer {
     pub fn figures(self) -> Figures {

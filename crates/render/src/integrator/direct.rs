@@ -1,0 +1,412 @@
+//! The direct-lighting estimator for one camera ray.
+//!
+//! All densities are in solid angle. The light technique's density of a direction is
+//! pmf(emitter) * pdf_emitter(direction); the BSDF technique's is the BSDF's pdf. Multi-sample
+//! MIS weights each technique with h(n_i p_i, n_j p_j) (Veach's heuristics); one-sample MIS
+//! picks a technique with probability c_i and weights by h(c_i p_i, c_j p_j) / c_i.
+//!
+//! Paths only one technique can produce (delta BSDFs and delta lobes: BSDF sampling only;
+//! delta lights: light sampling only) are handled by that technique with weight 1 in every
+//! strategy, including the pure ones, so no strategy loses them and none counts them twice.
+
+use super::Strategy;
+use crate::bsdf::{BsdfSample, Material};
+use crate::emitter::{EmitterSelector, LightSample};
+use crate::geometry::{Hit, Ray, SurfacePoint};
+use crate::math::{luminance, Frame, Rgb};
+use crate::sampler::{LightDims, Sampler};
+use crate::scene::desc::{Heuristic, StrategyKind};
+use crate::scene::Scene;
+use glam::Vec3;
+
+/// The direct-illumination estimator of one strategy on one scene (the scalar path).
+pub struct Direct<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// The strategy it estimates with.
+    pub strategy: Strategy,
+    pub(super) selector: EmitterSelector,
+    has_delta_lights: bool,
+    /// RIS's candidate count, if it is above 1 (`ris:1` is its source strategy, power).
+    pub(super) ris: Option<u32>,
+}
+
+/// A light sample drawn: the point, its emitter's choice pmf and the density the estimate
+/// divides by (pmf * pdf, or RIS's 1 / W). MIS weights use pmf * pdf in every case: for RIS
+/// that is the density of its candidates, which BSDF-sampled hits also use (any density
+/// both techniques compute alike keeps the weights a partition of unity, and the RIS
+/// estimate f W stays unbiased for every weighted integrand).
+#[derive(Clone, Copy)]
+pub(super) struct LightDraw {
+    ls: LightSample,
+    pmf: f32,
+    p_div: f32,
+}
+
+#[inline]
+pub(super) fn heuristic(h: Heuristic, a: f32, b: f32) -> f32 {
+    let (a, b) = match h {
+        Heuristic::Balance => (a, b),
+        Heuristic::Power => (a * a, b * b),
+    };
+    if a == 0.0 || b.is_infinite() {
+        0.0
+    } else {
+        a / (a + b)
+    }
+}
+
+/// Shading context at a camera-ray hit.
+struct Shading<'m> {
+    sp: SurfacePoint,
+    frame: Frame,
+    wi: Vec3,
+    mat: &'m Material,
+}
+
+impl<'a> Direct<'a> {
+    /// The estimator of `strategy` on `scene`, with its emitter choice built.
+    pub fn new(scene: &'a Scene, strategy: Strategy) -> Self {
+        let selector = EmitterSelector::new(&scene.emitters, &scene.shapes, strategy.selection);
+        Direct {
+            scene,
+            strategy,
+            has_delta_lights: scene.emitters.iter().any(|e| e.is_delta()),
+            selector,
+            ris: strategy.selection.ris().filter(|&m| m > 1),
+        }
+    }
+
+    /// Radiance along a camera ray.
+    pub fn li(&self, ray: &Ray, rng: &mut impl Sampler) -> Rgb {
+        match self.scene.intersect(ray) {
+            Some(hit) => self.li_hit(ray, &hit.sp, rng),
+            None => Rgb::ZERO,
+        }
+    }
+
+    /// `li` given the camera ray's hit.
+    pub(super) fn li_hit(&self, ray: &Ray, sp: &SurfacePoint, rng: &mut impl Sampler) -> Rgb {
+        let scene = self.scene;
+        let mut l = Rgb::ZERO;
+        if !self.strategy.hide_emitters {
+            if let Some((_, e)) = scene.emitter_at(sp) {
+                l += e.le(sp, -ray.d);
+            }
+        }
+        let sh = self.shading(sp, ray.d);
+        let s = &self.strategy;
+        let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
+        // A delta BSDF gives light samples zero throughput: all its light arrives via BSDF
+        // samples, which then carry weight 1.
+        let delta_bsdf = sh.mat.is_delta();
+        // The pure strategies fall back to the other technique for the paths only it can
+        // produce (delta BSDFs for light sampling, delta lights for BSDF sampling): weight 1
+        // where the own technique's density is 0, else 0. Nothing is lost or counted twice.
+        let only_other = |_: f32, p_own: f32| if p_own == 0.0 { 1.0 } else { 0.0 };
+        match s.kind {
+            StrategyKind::Light if delta_bsdf => {
+                for _ in 0..s.emitter_samples {
+                    l += self.bsdf_sample(&sh, rng, only_other) / ne;
+                }
+            }
+            StrategyKind::Light => {
+                // A delta lobe beside lobes with a density (plastic's coating): light samples
+                // for the latter, and a BSDF sample each that counts only the delta lobe.
+                let delta_lobe = sh.mat.has_delta_lobe();
+                for _ in 0..s.emitter_samples {
+                    l += self.light_sample(&sh, rng, |_, _| 1.0) / ne;
+                    if delta_lobe {
+                        l += self.bsdf_sample(&sh, rng, only_other) / ne;
+                    }
+                }
+            }
+            StrategyKind::Bsdf => {
+                for _ in 0..s.bsdf_samples {
+                    l += self.bsdf_sample(&sh, rng, |_, _| 1.0) / nb;
+                }
+                if self.has_delta_lights && !delta_bsdf {
+                    for _ in 0..s.bsdf_samples {
+                        l += self.light_sample(&sh, rng, only_other) / nb;
+                    }
+                }
+            }
+            StrategyKind::Mis => {
+                let light_w = |pl, pb| heuristic(s.heuristic, ne * pl, nb * pb);
+                let ne_drawn = if delta_bsdf { 0.0 } else { ne };
+                let bsdf_w = |pb, pl| heuristic(s.heuristic, nb * pb, ne_drawn * pl);
+                let n_light = if delta_bsdf { 0 } else { s.emitter_samples };
+                for _ in 1..n_light {
+                    l += self.light_sample(&sh, rng, light_w) / ne;
+                }
+                // The last light sample and the first BSDF sample are drawn before either
+                // traces its ray (random numbers still in the same order): their square
+                // roots and divisions then overlap instead of waiting behind a traversal.
+                let mut n_bsdf = s.bsdf_samples;
+                if n_light > 0 && n_bsdf > 0 {
+                    let light = self.light_draw(&sh, rng);
+                    let bsdf = self.bsdf_draw(&sh, rng);
+                    l += self.light_finish(&sh, light, light_w) / ne;
+                    l += self.bsdf_finish(&sh, bsdf, bsdf_w) / nb;
+                    n_bsdf -= 1;
+                } else if n_light > 0 {
+                    l += self.light_sample(&sh, rng, light_w) / ne;
+                }
+                for _ in 0..n_bsdf {
+                    l += self.bsdf_sample(&sh, rng, bsdf_w) / nb;
+                }
+            }
+            StrategyKind::MisOneSample => {
+                let c_light = if delta_bsdf { 0.0 } else { ne / (ne + nb) };
+                let c_bsdf = 1.0 - c_light;
+                if rng.technique() < c_light {
+                    l += self.light_sample(&sh, rng, |pl, pb| {
+                        heuristic(s.heuristic, c_light * pl, c_bsdf * pb) / c_light
+                    });
+                } else {
+                    l += self.bsdf_sample(&sh, rng, |pb, pl| {
+                        heuristic(s.heuristic, c_bsdf * pb, c_light * pl) / c_bsdf
+                    });
+                }
+            }
+        }
+        l
+    }
+
+    /// The shading context of a camera ray of direction `d` that hit `sp`.
+    #[inline(always)]
+    fn shading(&self, sp: &SurfacePoint, d: Vec3) -> Shading<'_> {
+        let frame = Frame::from_normal(sp.ns);
+        Shading {
+            sp: *sp,
+            frame,
+            wi: frame.to_local(-d),
+            mat: self.scene.material(sp),
+        }
+    }
+
+    /// One light-technique sample. `weight(p_light, p_bsdf)` is its MIS weight divided by the
+    /// technique's selection probability; a delta light is asked with p_bsdf = 0, since no
+    /// other technique can produce it.
+    #[inline]
+    fn light_sample(
+        &self,
+        sh: &Shading,
+        rng: &mut impl Sampler,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
+        let drawn = self.light_draw(sh, rng);
+        self.light_finish(sh, drawn, weight)
+    }
+
+    /// The random half of a light sample: the emitter, its point and density.
+    #[inline(always)]
+    fn light_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<LightDraw> {
+        if let Some(m) = self.ris {
+            return self.ris_draw(sh, rng, m).map(|(d, _)| d);
+        }
+        let (ls, pmf) = self.candidate(sh, rng.light())?;
+        Some(LightDraw {
+            ls,
+            pmf,
+            p_div: pmf * ls.pdf,
+        })
+    }
+
+    /// An emitter chosen at the shading point and a point drawn on it, with numbers `u`.
+    #[inline(always)]
+    fn candidate(&self, sh: &Shading, u: LightDims) -> Option<(LightSample, f32)> {
+        let scene = self.scene;
+        let (ei, pmf) = self.selector.sample(sh.sp.p, sh.sp.ns, u.select)?;
+        let ls = scene.emitters[ei].sample(
+            &scene.shapes,
+            sh.sp.p,
+            u.primitive,
+            u.point,
+            self.strategy.light_sampling,
+        )?;
+        Some((ls, pmf))
+    }
+
+    /// Resampled importance sampling (Talbot 2005; Bitterli et al. 2020's weight): `m`
+    /// candidates drawn by power, one kept with probability proportional to
+    /// w = p_hat / (pmf * pdf), where p_hat is the luminance of its unshadowed contribution;
+    /// the estimate divides by m p_hat / sum(w). One number chooses (drawn first, with the
+    /// technique's dimension), rescaled after each candidate as a reservoir of one; each
+    /// candidate takes a light sample's numbers whether it is kept or not. Also returns the
+    /// kept candidate's numbers, from which the lane kernel draws it again.
+    #[inline(never)]
+    fn ris_draw(
+        &self,
+        sh: &Shading,
+        rng: &mut impl Sampler,
+        m: u32,
+    ) -> Option<(LightDraw, LightDims)> {
+        const BELOW_ONE: f64 = 1.0 - f64::EPSILON / 2.0;
+        let mut u = rng.technique() as f64;
+        let mut w_sum = 0.0f64;
+        let mut kept: Option<(LightSample, f32, f32, LightDims)> = None;
+        for _ in 0..m {
+            let dims = rng.light();
+            let Some((ls, pmf)) = self.candidate(sh, dims) else {
+                continue;
+            };
+            let (f, _) = sh.mat.eval_pdf(sh.wi, sh.frame.to_local(ls.wi));
+            let p_hat = luminance(f * ls.li);
+            let w = p_hat as f64 / (pmf as f64 * ls.pdf as f64);
+            if !(p_hat > 0.0 && w.is_finite()) {
+                continue;
+            }
+            w_sum += w;
+            let q = w / w_sum;
+            if u < q {
+                u = (u / q).min(BELOW_ONE);
+                kept = Some((ls, pmf, p_hat, dims));
+            } else {
+                u = ((u - q) / (1.0 - q)).min(BELOW_ONE);
+            }
+        }
+        let (ls, pmf, p_hat, dims) = kept?;
+        let drawn = LightDraw {
+            ls,
+            pmf,
+            p_div: (m as f64 * p_hat as f64 / w_sum) as f32,
+        };
+        Some((drawn, dims))
+    }
+
+    /// For the lane kernel, RIS's draw at a camera ray's hit `sp` (direction `d`), with `rng`
+    /// where `li` would receive it: the kept candidate's numbers and the density the estimate
+    /// divides by, or None if no candidate was kept. `rng` is left where `li` draws its BSDF
+    /// sample. Only for `ris:M` with M > 1.
+    pub(super) fn ris_for_lane(
+        &self,
+        sp: &SurfacePoint,
+        d: Vec3,
+        rng: &mut impl Sampler,
+    ) -> Option<(LightDims, f32)> {
+        let m = self.ris.expect("RIS over several candidates");
+        let sh = self.shading(sp, d);
+        self.ris_draw(&sh, rng, m)
+            .map(|(drawn, dims)| (dims, drawn.p_div))
+    }
+
+    /// The rest of a light sample: BSDF, visibility and weight.
+    #[inline(always)]
+    fn light_finish(
+        &self,
+        sh: &Shading,
+        drawn: Option<LightDraw>,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
+        let Some(LightDraw { ls, pmf, p_div }) = drawn else {
+            return Rgb::ZERO;
+        };
+        let wo = sh.frame.to_local(ls.wi);
+        let (f, pdf) = sh.mat.eval_pdf(sh.wi, wo);
+        if f == Rgb::ZERO || ls.li == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        if !self.scene.visible(&sh.sp, &ls) {
+            return Rgb::ZERO;
+        }
+        let p_light = pmf * ls.pdf;
+        let p_bsdf = if ls.delta { 0.0 } else { pdf };
+        let w = weight(p_light, p_bsdf);
+        f * ls.li * (w / p_div)
+    }
+
+    /// One BSDF-technique sample: follow the sampled direction and collect emission there.
+    /// Delta lobes are asked for their weight with p_light = 0 (light sampling cannot hit them).
+    #[inline]
+    fn bsdf_sample(
+        &self,
+        sh: &Shading,
+        rng: &mut impl Sampler,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
+        let drawn = self.bsdf_draw(sh, rng);
+        self.bsdf_finish(sh, drawn, weight)
+    }
+
+    /// The random half of a BSDF sample.
+    #[inline(always)]
+    fn bsdf_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<BsdfSample> {
+        let u = rng.bsdf();
+        sh.mat.sample(sh.wi, u.lobe, u.direction)
+    }
+
+    /// The rest of a BSDF sample: its ray, the emitter it reaches and the weight.
+    #[inline(always)]
+    fn bsdf_finish(
+        &self,
+        sh: &Shading,
+        drawn: Option<BsdfSample>,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
+        let scene = self.scene;
+        let Some(bs) = drawn else {
+            return Rgb::ZERO;
+        };
+        let d = sh.frame.to_world(bs.wo);
+        let (ray, emitter_skip) = scene.bsdf_ray(&sh.sp, d);
+        self.bsdf_arrive(&sh.sp, &ray, emitter_skip, &bs, weight)
+    }
+
+    /// A BSDF sample's ray from `from` traced: the emission it reaches, weighted.
+    #[inline(always)]
+    pub(super) fn bsdf_arrive(
+        &self,
+        from: &SurfacePoint,
+        ray: &Ray,
+        emitter_skip: u32,
+        bs: &BsdfSample,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
+        match self.scene.bsdf_ray_hit(ray, emitter_skip) {
+            Some(hit) => self.bsdf_emission(from, ray.d, &hit, bs, weight),
+            None => Rgb::ZERO,
+        }
+    }
+
+    /// `bsdf_arrive` once its ray (from `from`, direction `d`) has hit `hit`.
+    #[inline(always)]
+    pub(super) fn bsdf_emission(
+        &self,
+        from: &SurfacePoint,
+        d: Vec3,
+        hit: &Hit,
+        bs: &BsdfSample,
+        weight: impl Fn(f32, f32) -> f32,
+    ) -> Rgb {
+        let scene = self.scene;
+        let Some((ei, e)) = scene.emitter_at(&hit.sp) else {
+            return Rgb::ZERO;
+        };
+        let le = e.le(&hit.sp, -d);
+        if le == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        let p_light = if bs.delta {
+            0.0
+        } else {
+            self.selector.pmf(from.p, from.ns, ei)
+                * e.pdf(&scene.shapes, from.p, &hit.sp, self.strategy.light_sampling)
+        };
+        let w = weight(bs.pdf, p_light);
+        bs.weight * le * w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn heuristics() {
+        assert_eq!(heuristic(Heuristic::Balance, 1.0, 3.0), 0.25);
+        assert_eq!(heuristic(Heuristic::Power, 1.0, 3.0), 0.1);
+        assert_eq!(heuristic(Heuristic::Balance, 0.0, 0.0), 0.0);
+        assert_eq!(heuristic(Heuristic::Balance, 2.0, 0.0), 1.0);
+    }
+}

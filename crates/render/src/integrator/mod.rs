@@ -1,0 +1,17 @@
+//! Direct-illumination estimators: light sampling, BSDF sampling and their MIS combinations
+//! (`Direct`, one camera ray at a time), and the lane kernel that runs the same estimator on
+//! eight camera samples at once (`LaneKernel`).
+
+mod direct;
+mod lanes;
+mod strategy;
+
+pub use direct::Direct;
+pub use lanes::{LaneKernel, LaneScratch};
+pub use strategy::{Strategy, StrategyOverrides};
+
+#[cfg(test)]
+mod coated_tests;
+#[cfg(test)]
+#[cfg(test)]
+pub(crate) mod tests;

@@ -1,0 +1,71 @@
+//! The README's and the experiment guide's lists of plug-ins are the registries': every
+//! option's list of values in the README's render table, the BSDFs it names and the metrics
+//! `experiments/README.md` lists equal what is registered, so a plug-in added or renamed
+//! without its documentation fails here.
+
+mod common;
+
+use common::repo;
+use directlab::emitter::RULES;
+use directlab::named::Named;
+
+fn readme() -> String {
+    std::fs::read_to_string(repo("README.md")).unwrap()
+}
+
+/// The values the README's render-options table gives for `option` (`--x a\|b\|c`).
+fn listed(readme: &str, option: &str) -> Vec<String> {
+    let at = readme
+        .find(&format!("`{option} "))
+        .unwrap_or_else(|| panic!("README has no row for {option}"));
+    let rest = &readme[at + option.len() + 2..];
+    let end = rest.find('`').unwrap();
+    rest[..end].split("\\|").map(str::to_string).collect()
+}
+
+fn names<T: Named>() -> Vec<String> {
+    T::CHOICES.iter().map(|c| c.name.to_string()).collect()
+}
+
+#[test]
+fn render_options_list_the_registered_values() {
+    use directlab::emitter::LightSampling;
+    use directlab::sampler::{DimAlloc, SamplerKind};
+    use directlab::scene::desc::{Heuristic, StrategyKind};
+    let r = readme();
+    assert_eq!(listed(&r, "--strategy"), names::<StrategyKind>());
+    assert_eq!(listed(&r, "--heuristic"), names::<Heuristic>());
+    assert_eq!(listed(&r, "--light-sampling"), names::<LightSampling>());
+    assert_eq!(listed(&r, "--sampler"), names::<SamplerKind>());
+    assert_eq!(listed(&r, "--dims"), names::<DimAlloc>());
+    let mut rules: Vec<String> = RULES.iter().map(|r| r.1.to_string()).collect();
+    rules.push("ris:M".into());
+    assert_eq!(listed(&r, "--emitter-selection"), rules);
+}
+
+#[test]
+fn every_registered_bsdf_is_named_in_the_readme() {
+    let r = readme();
+    let scenes = &r[r.find("- **Scenes**").unwrap()..];
+    let scenes = &scenes[..scenes.find("\n- **").unwrap()];
+    for name in directlab::bsdf::REGISTERED {
+        assert!(
+            scenes.contains(&format!("`{name}`")),
+            "README does not name BSDF {name}"
+        );
+    }
+}
+
+#[test]
+fn the_experiment_guide_lists_every_registered_metric() {
+    let guide = std::fs::read_to_string(repo("experiments/README.md")).unwrap();
+    let line = guide
+        .lines()
+        .find(|l| l.starts_with("report = ["))
+        .expect("experiments/README.md shows `report = [...]`");
+    let want: Vec<String> = directlab::experiment::metric::EXTRA_METRICS
+        .iter()
+        .map(|d| format!("\"{}\"", d.slug))
+        .collect();
+    assert_eq!(line, format!("report = [{}]", want.join(", ")));
+}
