@@ -5,8 +5,7 @@
 //! `ris:M` is not a rule: it resamples M candidates drawn by power, and the resampling itself
 //! needs the BSDF and lives in the integrator, so here it is the power rule.
 
-use super::rules::ChoiceRule;
-use super::rules::{exhaustive, power, uniform};
+use super::rules::{self, ChoiceRule};
 use super::tree::LightTree;
 use super::Emitter;
 use crate::geometry::Shape;
@@ -41,7 +40,7 @@ macro_rules! rules {
                 match mode {
                     $(EmitterSelection::$variant => Rule::$variant(<$ty as ChoiceRule>::build(emitters, shapes)),)*
                     EmitterSelection::Ris(_) => {
-                        Rule::Power(<power::Power as ChoiceRule>::build(emitters, shapes))
+                        Rule::Power(<rules::power::Power as ChoiceRule>::build(emitters, shapes))
                     }
                 }
             }
@@ -98,9 +97,9 @@ macro_rules! rules {
 }
 
 rules! {
-    Uniform(uniform::Uniform) = "uniform", "uni", "every emitter with the same probability";
-    Power(power::Power) = "power", "pow", "in proportion to emitted power";
-    Exhaustive(exhaustive::Exhaustive) = "exhaustive", "exh",
+    Uniform(rules::uniform::Uniform) = "uniform", "uni", "every emitter with the same probability";
+    Power(rules::power::Power) = "power", "pow", "in proportion to emitted power";
+    Exhaustive(rules::exhaustive::Exhaustive) = "exhaustive", "exh",
         "each emitter's importance at the shading point: O(N) per choice, the oracle";
     Bvh(LightTree) = "bvh", "bvh",
         "a light tree (pbrt-v4's BVH light sampler): O(log N) per choice";

@@ -11,12 +11,13 @@
 //! balance heuristic; Mitsuba: 768x576, 4 spp, near clip 0.01, power heuristic).
 //!
 //! Supported plugins: integrator `direct` (+ Nori's `sampling` string, `direct_ems`,
-//! `direct_mats`, `direct_mis`); sensor `perspective` (fov, or Mitsuba's focal_length with its
-//! 50 mm default, which is a diagonal fov); film `hdrfilm` (`ldrfilm` read as
-//! hdrfilm); rfilter `box`, `tent`, `gaussian`; sampler `independent` (other Mitsuba samplers
-//! are replaced by it, with a warning); bsdf `diffuse`, `twosided`, `conductor`,
-//! `roughconductor`, `dielectric`, `mirror`, `microfacet`; shape `obj`, `rectangle`, `cube`,
-//! `sphere`; emitter `area` (nested in a shape), `point`, `pointlight`.
+//! `direct_mats`, `direct_mis`, and the direct part of path tracers under `--integrator
+//! direct`); sensor `perspective` (fov, or Mitsuba's focal_length with its 50 mm default,
+//! which is a diagonal fov); film `hdrfilm` (`ldrfilm` read as hdrfilm); rfilter `box`,
+//! `tent`, `gaussian`; sampler: every registered [`crate::sampler::SamplerKind`] by its name,
+//! Mitsuba's other samplers mapped to the nearest with a warning; bsdf: every registered BSDF
+//! ([`crate::bsdf::REGISTERED`]) and `twosided`; shape `obj`, `rectangle`, `cube`, `sphere`;
+//! emitter `area` (nested in a shape), `point`, `pointlight`.
 //!
 //! Everything else is an error naming the file, line and element: unknown types and
 //! parameters, known-but-unsupported plugins ("not supported yet"), malformed or non-finite
