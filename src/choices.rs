@@ -8,6 +8,7 @@ use crate::named::Named;
 use crate::scene::desc::{Heuristic, StrategyKind};
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::Args;
+use std::ffi::OsStr;
 
 /// A clap value parser for the set `T`: its names as the possible values, with their help.
 pub fn named<T: Named + Clone + Send + Sync>() -> impl TypedValueParser<Value = T> {
@@ -19,6 +20,43 @@ pub fn named<T: Named + Clone + Send + Sync>() -> impl TypedValueParser<Value = 
     .map(|s| T::from_name(&s).expect("clap accepts only the table's names"))
 }
 
+/// The emitter choices' parser: the registered rules' names and help (`emitter::RULES`) and
+/// `ris:M`, parsed by `EmitterSelection`'s own `FromStr` (whose error lists them too).
+#[derive(Clone, Copy, Debug)]
+pub struct EmitterSelectionParser;
+
+impl TypedValueParser for EmitterSelectionParser {
+    type Value = EmitterSelection;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &OsStr,
+    ) -> Result<EmitterSelection, clap::Error> {
+        let text = value.to_string_lossy();
+        text.parse().map_err(|e: String| {
+            let name = arg.map_or("value".to_string(), |a| a.to_string());
+            clap::Error::raw(
+                clap::error::ErrorKind::InvalidValue,
+                format!("invalid value '{text}' for '{name}': {e}\n"),
+            )
+            .with_cmd(cmd)
+        })
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        let rules = crate::emitter::RULES
+            .iter()
+            .map(|r| PossibleValue::new(r.1).help(r.3));
+        let ris = PossibleValue::new("ris:M").help(format!(
+            "resampling of M candidates drawn by power, M from 1 to {}",
+            crate::emitter::RIS_MAX
+        ));
+        Some(Box::new(rules.chain([ris])))
+    }
+}
+
 /// Estimator choices on top of a scene's own integrator settings (`render`'s options; the
 /// experiment files' strategy entries have the same names). Anything not given keeps the
 /// scene's setting.
@@ -27,9 +65,8 @@ pub struct StrategyArgs {
     /// The estimator (default: the scene's integrator).
     #[arg(long, value_parser = named::<StrategyKind>())]
     pub strategy: Option<StrategyKind>,
-    /// Emitter choice: uniform, power, exhaustive (each light's importance at the shading
-    /// point, O(N)), bvh (a light tree) or ris:M (M candidates by power, 1 to 256).
-    #[arg(long)]
+    /// Emitter choice (default: uniform, the study's).
+    #[arg(long, value_parser = EmitterSelectionParser)]
     pub emitter_selection: Option<EmitterSelection>,
     /// How points on area lights are drawn.
     #[arg(long, value_parser = named::<LightSampling>())]

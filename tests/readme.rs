@@ -69,3 +69,47 @@ fn the_experiment_guide_lists_every_registered_metric() {
         .collect();
     assert_eq!(line, format!("report = [{}]", want.join(", ")));
 }
+
+/// `render --help` lists every registered value with its help, and a wrong value is refused
+/// with the valid names.
+#[test]
+fn the_command_line_lists_and_checks_the_registered_values() {
+    use directlab::sampler::SamplerKind;
+    let help = common::run(common::directlab().args(["render", "--help"]));
+    let help = String::from_utf8_lossy(&help.stdout).to_string();
+    for r in RULES {
+        assert!(
+            help.contains(&format!("- {}:", r.1)) && help.contains(r.3),
+            "{help}"
+        );
+    }
+    for c in SamplerKind::CHOICES {
+        assert!(
+            help.contains(&format!("- {}:", c.name)) && help.contains(c.help),
+            "{help}"
+        );
+    }
+    for (option, bad, says) in [
+        (
+            "--emitter-selection",
+            "tree",
+            "expected uniform, power, exhaustive, bvh or ris:M",
+        ),
+        (
+            "--sampler",
+            "halton",
+            "possible values: independent, stratified",
+        ),
+        (
+            "--strategy",
+            "path",
+            "possible values: bsdf, light, mis, mis-onesample",
+        ),
+    ] {
+        let o =
+            common::run(common::directlab().args(["render", "scenes/cbox/cbox.xml", option, bad]));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{option} {bad}: {err}");
+        assert!(err.contains(says), "{option} {bad}: {err}");
+    }
+}

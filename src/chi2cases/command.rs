@@ -39,7 +39,7 @@ pub struct Chi2Args {
     #[arg(long)]
     pub scene: Option<PathBuf>,
     /// The scene's emitter choice (default: uniform, the study's).
-    #[arg(long, default_value = "uniform")]
+    #[arg(long, default_value = "uniform", value_parser = crate::choices::EmitterSelectionParser)]
     pub emitter_selection: crate::emitter::EmitterSelection,
     /// The scene's light sampling.
     #[arg(long, value_parser = crate::choices::named::<crate::emitter::LightSampling>(), default_value = "area")]

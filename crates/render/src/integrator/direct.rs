@@ -1,13 +1,10 @@
-//! The direct-lighting estimator for one camera ray.
+//! The direct-lighting estimator for one camera ray: the techniques (light and BSDF samples
+//! with their MIS weights, RIS) that the strategies of `strategies/` combine.
 //!
 //! All densities are in solid angle. The light technique's density of a direction is
 //! pmf(emitter) * pdf_emitter(direction); the BSDF technique's is the BSDF's pdf. Multi-sample
 //! MIS weights each technique with h(n_i p_i, n_j p_j) (Veach's heuristics); one-sample MIS
 //! picks a technique with probability c_i and weights by h(c_i p_i, c_j p_j) / c_i.
-//!
-//! Paths only one technique can produce (delta BSDFs and delta lobes: BSDF sampling only;
-//! delta lights: light sampling only) are handled by that technique with weight 1 in every
-//! strategy, including the pure ones, so no strategy loses them and none counts them twice.
 
 use super::Strategy;
 use crate::bsdf::{BsdfSample, Material};
@@ -15,7 +12,7 @@ use crate::emitter::{EmitterSelector, LightSample};
 use crate::geometry::{Hit, Ray, SurfacePoint};
 use crate::math::{luminance, Frame, Rgb};
 use crate::sampler::{LightDims, Sampler};
-use crate::scene::desc::{Heuristic, StrategyKind};
+use crate::scene::desc::Heuristic;
 use crate::scene::Scene;
 use glam::Vec3;
 
@@ -57,11 +54,11 @@ pub(super) fn heuristic(h: Heuristic, a: f32, b: f32) -> f32 {
 }
 
 /// Shading context at a camera-ray hit.
-struct Shading<'m> {
-    sp: SurfacePoint,
-    frame: Frame,
-    wi: Vec3,
-    mat: &'m Material,
+pub(super) struct Shading<'m> {
+    pub(super) sp: SurfacePoint,
+    pub(super) frame: Frame,
+    pub(super) wi: Vec3,
+    pub(super) mat: &'m Material,
 }
 
 impl<'a> Direct<'a> {
@@ -95,82 +92,26 @@ impl<'a> Direct<'a> {
             }
         }
         let sh = self.shading(sp, ray.d);
-        let s = &self.strategy;
-        let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
         // A delta BSDF gives light samples zero throughput: all its light arrives via BSDF
         // samples, which then carry weight 1.
         let delta_bsdf = sh.mat.is_delta();
-        // The pure strategies fall back to the other technique for the paths only it can
-        // produce (delta BSDFs for light sampling, delta lights for BSDF sampling): weight 1
-        // where the own technique's density is 0, else 0. Nothing is lost or counted twice.
-        let only_other = |_: f32, p_own: f32| if p_own == 0.0 { 1.0 } else { 0.0 };
-        match s.kind {
-            StrategyKind::Light if delta_bsdf => {
-                for _ in 0..s.emitter_samples {
-                    l += self.bsdf_sample(&sh, rng, only_other) / ne;
-                }
-            }
-            StrategyKind::Light => {
-                // A delta lobe beside lobes with a density (plastic's coating): light samples
-                // for the latter, and a BSDF sample each that counts only the delta lobe.
-                let delta_lobe = sh.mat.has_delta_lobe();
-                for _ in 0..s.emitter_samples {
-                    l += self.light_sample(&sh, rng, |_, _| 1.0) / ne;
-                    if delta_lobe {
-                        l += self.bsdf_sample(&sh, rng, only_other) / ne;
-                    }
-                }
-            }
-            StrategyKind::Bsdf => {
-                for _ in 0..s.bsdf_samples {
-                    l += self.bsdf_sample(&sh, rng, |_, _| 1.0) / nb;
-                }
-                if self.has_delta_lights && !delta_bsdf {
-                    for _ in 0..s.bsdf_samples {
-                        l += self.light_sample(&sh, rng, only_other) / nb;
-                    }
-                }
-            }
-            StrategyKind::Mis => {
-                let light_w = |pl, pb| heuristic(s.heuristic, ne * pl, nb * pb);
-                let ne_drawn = if delta_bsdf { 0.0 } else { ne };
-                let bsdf_w = |pb, pl| heuristic(s.heuristic, nb * pb, ne_drawn * pl);
-                let n_light = if delta_bsdf { 0 } else { s.emitter_samples };
-                for _ in 1..n_light {
-                    l += self.light_sample(&sh, rng, light_w) / ne;
-                }
-                // The last light sample and the first BSDF sample are drawn before either
-                // traces its ray (random numbers still in the same order): their square
-                // roots and divisions then overlap instead of waiting behind a traversal.
-                let mut n_bsdf = s.bsdf_samples;
-                if n_light > 0 && n_bsdf > 0 {
-                    let light = self.light_draw(&sh, rng);
-                    let bsdf = self.bsdf_draw(&sh, rng);
-                    l += self.light_finish(&sh, light, light_w) / ne;
-                    l += self.bsdf_finish(&sh, bsdf, bsdf_w) / nb;
-                    n_bsdf -= 1;
-                } else if n_light > 0 {
-                    l += self.light_sample(&sh, rng, light_w) / ne;
-                }
-                for _ in 0..n_bsdf {
-                    l += self.bsdf_sample(&sh, rng, bsdf_w) / nb;
-                }
-            }
-            StrategyKind::MisOneSample => {
-                let c_light = if delta_bsdf { 0.0 } else { ne / (ne + nb) };
-                let c_bsdf = 1.0 - c_light;
-                if rng.technique() < c_light {
-                    l += self.light_sample(&sh, rng, |pl, pb| {
-                        heuristic(s.heuristic, c_light * pl, c_bsdf * pb) / c_light
-                    });
-                } else {
-                    l += self.bsdf_sample(&sh, rng, |pb, pl| {
-                        heuristic(s.heuristic, c_bsdf * pb, c_light * pl) / c_bsdf
-                    });
-                }
-            }
+        super::strategies::li(self, &sh, delta_bsdf, rng, l)
+    }
+
+    /// The weight of the pure strategies' fallback to the other technique, for the paths only
+    /// it can produce (delta BSDFs for light sampling, delta lights for BSDF sampling): 1
+    /// where the own technique's density is 0, else 0. Nothing is lost or counted twice.
+    pub(super) fn only_other(_: f32, p_own: f32) -> f32 {
+        if p_own == 0.0 {
+            1.0
+        } else {
+            0.0
         }
-        l
+    }
+
+    /// Whether the scene has delta (point) lights, which BSDF samples never hit.
+    pub(super) fn has_delta_lights(&self) -> bool {
+        self.has_delta_lights
     }
 
     /// The shading context of a camera ray of direction `d` that hit `sp`.
@@ -189,7 +130,7 @@ impl<'a> Direct<'a> {
     /// technique's selection probability; a delta light is asked with p_bsdf = 0, since no
     /// other technique can produce it.
     #[inline]
-    fn light_sample(
+    pub(super) fn light_sample(
         &self,
         sh: &Shading,
         rng: &mut impl Sampler,
@@ -201,7 +142,7 @@ impl<'a> Direct<'a> {
 
     /// The random half of a light sample: the emitter, its point and density.
     #[inline(always)]
-    fn light_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<LightDraw> {
+    pub(super) fn light_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<LightDraw> {
         if let Some(m) = self.ris {
             return self.ris_draw(sh, rng, m).map(|(d, _)| d);
         }
@@ -293,7 +234,7 @@ impl<'a> Direct<'a> {
 
     /// The rest of a light sample: BSDF, visibility and weight.
     #[inline(always)]
-    fn light_finish(
+    pub(super) fn light_finish(
         &self,
         sh: &Shading,
         drawn: Option<LightDraw>,
@@ -319,7 +260,7 @@ impl<'a> Direct<'a> {
     /// One BSDF-technique sample: follow the sampled direction and collect emission there.
     /// Delta lobes are asked for their weight with p_light = 0 (light sampling cannot hit them).
     #[inline]
-    fn bsdf_sample(
+    pub(super) fn bsdf_sample(
         &self,
         sh: &Shading,
         rng: &mut impl Sampler,
@@ -331,14 +272,14 @@ impl<'a> Direct<'a> {
 
     /// The random half of a BSDF sample.
     #[inline(always)]
-    fn bsdf_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<BsdfSample> {
+    pub(super) fn bsdf_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<BsdfSample> {
         let u = rng.bsdf();
         sh.mat.sample(sh.wi, u.lobe, u.direction)
     }
 
     /// The rest of a BSDF sample: its ray, the emitter it reaches and the weight.
     #[inline(always)]
-    fn bsdf_finish(
+    pub(super) fn bsdf_finish(
         &self,
         sh: &Shading,
         drawn: Option<BsdfSample>,

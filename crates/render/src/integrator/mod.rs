@@ -4,6 +4,7 @@
 
 mod direct;
 mod lanes;
+mod strategies;
 mod strategy;
 
 pub use direct::Direct;

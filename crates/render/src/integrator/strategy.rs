@@ -1,7 +1,6 @@
 //! The estimator settings a render uses, and their stable short labels.
 
 use crate::emitter::{EmitterSelection, LightSampling};
-use crate::named::Named;
 use crate::scene::desc::{Heuristic, IntegratorDesc, StrategyKind};
 
 /// Everything that decides which estimator a render runs.
@@ -89,22 +88,10 @@ impl Strategy {
     }
 
     /// Stable label for file names, CSV rows and plot legends, e.g. `mis-power-e1b1-uni-area`:
-    /// the short forms of the kind, heuristic (MIS only), sample counts (`eN` light, `bM`
-    /// BSDF), emitter choice and light sampling, as far as the kind uses them.
+    /// the short forms of the kind, then of the settings its estimator uses (heuristic, `eN`
+    /// light and `bM` BSDF samples, emitter choice, light sampling).
     pub fn label(&self) -> String {
-        let (k, sel, ls) = (
-            self.kind.short(),
-            self.selection.short(),
-            self.light_sampling.short(),
-        );
-        let h = self.heuristic.short();
-        let (e, b) = (self.emitter_samples, self.bsdf_samples);
-        match self.kind {
-            StrategyKind::Light => format!("{k}-e{e}-{sel}-{ls}"),
-            StrategyKind::Bsdf => format!("{k}-b{b}"),
-            StrategyKind::Mis => format!("{k}-{h}-e{e}b{b}-{sel}-{ls}"),
-            StrategyKind::MisOneSample => format!("{k}-{h}-{sel}-{ls}"),
-        }
+        super::strategies::label(self)
     }
 }
 

@@ -1,0 +1,91 @@
+//! The estimators, one file each, and their registration (`estimators!`): how the hit of a
+//! camera ray is shaded under each [`StrategyKind`], and the strategy's label. A strategy's
+//! name, help and label short form are its row of `StrategyKind`'s table (`scene/desc.rs`,
+//! where scene files name it); its estimator is its file here and one line below. The
+//! registry tests check that every named strategy has an estimator.
+//!
+//! Paths only one technique can produce (delta BSDFs and delta lobes: BSDF sampling only;
+//! delta lights: light sampling only) are handled by that technique with weight 1 in every
+//! strategy, including the pure ones, so no strategy loses them and none counts them twice.
+
+mod bsdf;
+mod light;
+mod mis;
+mod mis_onesample;
+
+use super::direct::{Direct, Shading};
+use super::Strategy;
+use crate::math::Rgb;
+use crate::named::Named;
+use crate::sampler::Sampler;
+use crate::scene::desc::StrategyKind;
+
+/// An estimator of the light a camera ray's hit receives directly.
+pub(super) trait Estimator {
+    /// The strategy it estimates for.
+    const KIND: StrategyKind;
+    /// `l` (the emission the camera ray sees) plus the estimate at the shading point `sh`,
+    /// each sample's term added to `l` in turn. `delta_bsdf`: every lobe of the material is
+    /// a delta.
+    fn li(d: &Direct, sh: &Shading, delta_bsdf: bool, rng: &mut impl Sampler, l: Rgb) -> Rgb;
+    /// The settings the strategy uses, after the kind's short form in its label: heuristic
+    /// `h`, light samples `eN`, BSDF samples `bM`, emitter choice `sel`, light sampling `ls`.
+    fn label(s: &Strategy, h: &str, sel: &str, ls: &str) -> String;
+}
+
+macro_rules! estimators {
+    ($($ty:path),* $(,)?) => {
+        /// The estimate of `d`'s strategy at `sh`.
+        #[inline(always)]
+        pub(super) fn li(
+            d: &Direct,
+            sh: &Shading,
+            delta_bsdf: bool,
+            rng: &mut impl Sampler,
+            l: Rgb,
+        ) -> Rgb {
+            let kind = d.strategy.kind;
+            $(if kind == <$ty as Estimator>::KIND {
+                return <$ty as Estimator>::li(d, sh, delta_bsdf, rng, l);
+            })*
+            unreachable!("every strategy has an estimator (registry tests)")
+        }
+
+        /// The strategy's stable label (see [`Strategy::label`]).
+        pub(super) fn label(s: &Strategy) -> String {
+            let (h, sel, ls) = (s.heuristic.short(), s.selection.short(), s.light_sampling.short());
+            let rest = [$((<$ty as Estimator>::KIND, <$ty as Estimator>::label as fn(&Strategy, &str, &str, &str) -> String)),*]
+                .into_iter()
+                .find(|(k, _)| *k == s.kind)
+                .map(|(_, f)| f(s, h, &sel, ls))
+                .expect("every strategy has an estimator (registry tests)");
+            format!("{}-{rest}", s.kind.short())
+        }
+
+        /// The strategies with an estimator, in registration order.
+        #[cfg(test)]
+        pub(super) const REGISTERED: &[StrategyKind] = &[$(<$ty as Estimator>::KIND),*];
+    };
+}
+
+estimators!(
+    light::Light,
+    bsdf::Bsdf,
+    mis::Mis,
+    mis_onesample::MisOneSample,
+);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_named_strategy_has_one_estimator() {
+        let mut named = StrategyKind::all();
+        let mut registered = REGISTERED.to_vec();
+        let key = |k: &StrategyKind| k.name();
+        named.sort_by_key(key);
+        registered.sort_by_key(key);
+        assert_eq!(named, registered);
+    }
+}
