@@ -4,12 +4,16 @@
 //! its name in `metrics.csv`, its caption, its `Row` column, its epsilon and tone mapping and
 //! the function that computes it; parsing, the error listing valid names, `results.csv`,
 //! `metrics.csv`, the captions and the convergence plots follow. A metric is then one
-//! function in `src/metrics/` and one line here (plus its `Row` column), and the tests below
-//! fail until it has a hand-computed case.
+//! function in `src/metrics/` with its hand-computed case beside it (the line names it, so a
+//! line cannot be written without one) and one line here, plus its `Row` column.
 
 use super::results::Row;
 use crate::film::Image;
-use crate::metrics::{flip, pointwise, ssim};
+pub use crate::metrics::Inputs;
+use crate::metrics::{flip, pointwise, ssim, Compute};
+use crate::output::write_atomic;
+use serde::Serialize;
+use std::path::Path;
 
 /// The epsilon a metric is defined with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -20,16 +24,6 @@ pub enum Eps {
     Relmse,
     /// MAPE's (`metrics.mape_epsilon`).
     Mape,
-}
-
-/// What a metric is computed from.
-pub struct Inputs<'a> {
-    pub img: &'a Image,
-    pub reference: &'a Image,
-    pub relmse_eps: f64,
-    pub mape_eps: f64,
-    /// The tone mapping's exposure (the figures').
-    pub exposure: f64,
 }
 
 /// A metric reported beside MSE and relMSE.
@@ -52,14 +46,14 @@ pub struct MetricDef {
     pub set: fn(&mut Row, Option<f64>),
     /// Computes it (None where it does not apply, such as SSIM on a film smaller than its
     /// window).
-    pub compute: fn(&Inputs) -> Option<f64>,
+    pub compute: Compute,
 }
 
 macro_rules! metrics {
     ($($variant:ident {
         slug: $slug:literal, long: $long:literal, short: $short:literal, field: $field:ident,
         eps: $eps:ident, tone_mapped: $tone:literal, detail: $detail:literal,
-        compute: $compute:expr, doc: $doc:literal $(,)?
+        compute: $compute:expr, hand: $hand:path, doc: $doc:literal $(,)?
     })*) => {
         /// An error of a render against the reference. MSE and relMSE are corrected for the
         /// reference's noise and have predicted values (they can be `primary`); the others
@@ -87,6 +81,11 @@ macro_rules! metrics {
             set: |r: &mut Row, v| r.$field = v,
             compute: $compute,
         },)*];
+
+        /// Each registered metric's hand-computed case (a function beside the metric, given
+        /// the line's `compute`): a line cannot be written without one.
+        #[cfg(test)]
+        pub(crate) const HAND: &[(&str, fn(Compute))] = &[$(($slug, $hand)),*];
     };
 }
 
@@ -96,18 +95,21 @@ metrics! {
         field: trimmed_relmse, eps: Relmse, tone_mapped: false,
         detail: "largest 0.1 % dropped",
         compute: |i| Some(pointwise::trimmed_rel_mse(i.img, i.reference, i.relmse_eps, pointwise::TRIM)),
+        hand: pointwise::hand::trimmed_relmse,
         doc: "relMSE without its largest 0.1 % of terms.",
     }
     Mape {
         slug: "mape", long: "mape", short: "MAPE", field: mape, eps: Mape,
         tone_mapped: false, detail: "",
         compute: |i| Some(pointwise::mape(i.img, i.reference, i.mape_eps)),
+        hand: pointwise::hand::mape,
         doc: "mean |x - r| / (|r| + eps).",
     }
     Smape {
         slug: "smape", long: "smape", short: "SMAPE", field: smape, eps: Mape,
         tone_mapped: false, detail: "no factor 2",
         compute: |i| Some(pointwise::smape(i.img, i.reference, i.mape_eps)),
+        hand: pointwise::hand::smape,
         doc: "mean |x - r| / (|x| + |r| + eps), without a factor 2.",
     }
     Ssim {
@@ -118,12 +120,14 @@ metrics! {
             let (w, h) = (i.img.width as usize, i.img.height as usize);
             ssim::ssim(&tm(i.img), &tm(i.reference), w, h).map(|s| 1.0 - s)
         },
+        hand: ssim::hand::ssim_error,
         doc: "1 - SSIM on tone-mapped sRGB.",
     }
     Flip {
         slug: "flip", long: "flip", short: "FLIP", field: flip, eps: None,
         tone_mapped: true, detail: "67 ppd",
         compute: |i| Some(flip::flip(i.img, i.reference, i.exposure)),
+        hand: flip::hand::flip,
         doc: "Mean FLIP on tone-mapped 8-bit sRGB.",
     }
 }
@@ -224,6 +228,81 @@ impl TryFrom<String> for ErrorMetric {
     fn try_from(s: String) -> Result<Self, String> {
         s.parse()
     }
+}
+
+/// One value of `metrics.csv`: a run's error in one metric, named with what defines it.
+#[derive(Serialize)]
+struct MetricRow<'a> {
+    case: &'a str,
+    strategy: &'a str,
+    name: &'a str,
+    kind: &'a str,
+    budget_s: f64,
+    spp: u32,
+    seed: u64,
+    metric: &'static str,
+    /// Empty where the metric has none.
+    epsilon: Option<f64>,
+    /// "linear" or the display transform SSIM and FLIP compare.
+    tone_mapping: String,
+    /// MSE and relMSE as measured (not corrected for the reference's noise; results.csv has
+    /// both).
+    value: f64,
+}
+
+/// `metrics.csv`: every run's every measured metric, one per row, each row naming the
+/// metric, its epsilon and its tone mapping.
+pub fn write_long(path: &Path, rows: &[Row]) -> Result<(), String> {
+    use ErrorMetric as M;
+    write_atomic(path, |tmp| {
+        let mut w = csv::Writer::from_path(tmp).map_err(|e| e.to_string())?;
+        for r in rows {
+            let tm = |e: Option<f64>| match e {
+                Some(x) => format!("exposure {x}; clamp to [0 1]; sRGB"),
+                None => String::new(),
+            };
+            let mut values = vec![
+                (M::Mse, Some(r.mse), None, String::from("linear")),
+                (
+                    M::Relmse,
+                    Some(r.relmse),
+                    Some(r.relmse_eps),
+                    "linear".into(),
+                ),
+            ];
+            for d in EXTRA_METRICS {
+                let epsilon = match d.eps {
+                    Eps::None => None,
+                    Eps::Relmse => Some(r.relmse_eps),
+                    Eps::Mape => r.mape_eps,
+                };
+                let tone = if d.tone_mapped {
+                    tm(r.exposure)
+                } else {
+                    "linear".into()
+                };
+                values.push((d.metric, (d.value)(r), epsilon, tone));
+            }
+            for (m, v, epsilon, tone_mapping) in values {
+                let Some(value) = v else { continue };
+                w.serialize(MetricRow {
+                    case: &r.case,
+                    strategy: &r.strategy,
+                    name: &r.name,
+                    kind: &r.kind,
+                    budget_s: r.budget_s,
+                    spp: r.spp,
+                    seed: r.seed,
+                    metric: m.long(),
+                    epsilon,
+                    tone_mapping,
+                    value,
+                })
+                .map_err(|e| e.to_string())?;
+            }
+        }
+        w.flush().map_err(|e| e.to_string())
+    })
 }
 
 #[cfg(test)]

@@ -28,3 +28,22 @@ pub fn flip_srgb8(test: &[u8], reference: &[u8], width: u32, height: u32) -> f64
     let v = map.to_vec();
     v.iter().map(|&e| e as f64).sum::<f64>() / v.len().max(1) as f64
 }
+
+/// The case of the registered FLIP, run through its registry line. (Its value on a real pair
+/// equals NVIDIA's own implementation: `metrics::reference_tests`.)
+#[cfg(test)]
+pub(crate) mod hand {
+    use crate::metrics::{close, constant, run, Compute};
+
+    pub(crate) fn flip(compute: Compute) {
+        let a = constant(16, 16, 0.3);
+        close(
+            run(compute, &a, &a, 0.01, 0.01),
+            0.0,
+            "flip of identical images",
+        );
+        let b = constant(16, 16, 0.6);
+        let d = run(compute, &a, &b, 0.01, 0.01).unwrap();
+        assert!(d > 0.0 && d <= 1.0, "flip {d}");
+    }
+}

@@ -7,6 +7,65 @@ pub mod ssim;
 use crate::film::Image;
 use statrs::distribution::{ContinuousCDF, Normal};
 
+/// What a registered metric is computed from (`experiment::metric`).
+pub struct Inputs<'a> {
+    pub img: &'a Image,
+    pub reference: &'a Image,
+    pub relmse_eps: f64,
+    pub mape_eps: f64,
+    /// The tone mapping's exposure (the figures').
+    pub exposure: f64,
+}
+
+/// A registered metric's computation, as its registry line gives it.
+pub type Compute = fn(&Inputs) -> Option<f64>;
+
+/// A one-row image of grey pixels (the metrics' hand-computed cases).
+#[cfg(test)]
+pub(crate) fn grey(v: &[f64]) -> Image {
+    let mut i = Image::new(v.len() as u32, 1);
+    for (k, &x) in v.iter().enumerate() {
+        i.set(k as u32, 0, [x; 3]);
+    }
+    i
+}
+
+/// A constant `w` x `h` image (the metrics' hand-computed cases).
+#[cfg(test)]
+pub(crate) fn constant(w: u32, h: u32, v: f64) -> Image {
+    let mut i = Image::new(w, h);
+    i.data.fill([v; 3]);
+    i
+}
+
+/// `compute` of `img` against `reference` (exposure 1), for the hand-computed cases.
+#[cfg(test)]
+pub(crate) fn run(
+    compute: Compute,
+    img: &Image,
+    reference: &Image,
+    eps: f64,
+    mape_eps: f64,
+) -> Option<f64> {
+    compute(&Inputs {
+        img,
+        reference,
+        relmse_eps: eps,
+        mape_eps,
+        exposure: 1.0,
+    })
+}
+
+/// Asserts `got` is `want` to 1e-12 relative.
+#[cfg(test)]
+pub(crate) fn close(got: Option<f64>, want: f64, what: &str) {
+    let g = got.unwrap_or_else(|| panic!("{what}: no value"));
+    assert!(
+        (g - want).abs() <= 1e-12 * want.abs().max(1.0),
+        "{what}: {g} vs {want}"
+    );
+}
+
 /// Mean squared error over all pixels and channels.
 pub fn mse(img: &Image, reference: &Image) -> f64 {
     assert_eq!((img.width, img.height), (reference.width, reference.height));

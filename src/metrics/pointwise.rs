@@ -100,3 +100,38 @@ mod tests {
         assert!((trimmed - want).abs() < 1e-15, "{trimmed} vs {want}");
     }
 }
+
+/// Hand-computed cases of the registered metrics of this file, run through their registry
+/// lines' `compute` (`experiment::metric` names each).
+#[cfg(test)]
+pub(crate) mod hand {
+    use crate::metrics::{close, constant, grey, run, Compute};
+
+    pub(crate) fn trimmed_relmse(compute: Compute) {
+        // 2000 pixels of 1.0 against 1.0 except one firefly of 11: 6000 terms, 0.1 % is 6,
+        // the firefly's three channels and three zeros: nothing is left.
+        let r = constant(2000, 1, 1.0);
+        let mut x = r.clone();
+        x.data[7] = [11.0; 3];
+        close(run(compute, &x, &r, 0.01, 0.5), 0.0, "firefly trimmed");
+        // An error everywhere is kept: (0.1^2 / 1.01) per term, whichever 6 are dropped.
+        let y = constant(2000, 1, 1.1);
+        close(
+            run(compute, &y, &r, 0.01, 0.5),
+            0.01 / 1.01,
+            "uniform error",
+        );
+    }
+
+    pub(crate) fn mape(compute: Compute) {
+        let (r, x) = (grey(&[1.0, 0.0, 2.0, 0.5]), grey(&[1.5, 0.1, 2.0, 0.0]));
+        let want = (0.5 / 1.01 + 0.1 / 0.01 + 0.0 + 0.5 / 0.51) / 4.0;
+        close(run(compute, &x, &r, 0.5, 0.01), want, "mape");
+    }
+
+    pub(crate) fn smape(compute: Compute) {
+        let (r, x) = (grey(&[1.0, 0.0, 2.0, 0.5]), grey(&[1.5, 0.1, 2.0, 0.0]));
+        let want = (0.5 / 2.51 + 0.1 / 0.11 + 0.0 + 0.5 / 0.51) / 4.0;
+        close(run(compute, &x, &r, 0.5, 0.01), want, "smape");
+    }
+}

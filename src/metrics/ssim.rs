@@ -124,3 +124,23 @@ mod tests {
         assert!(s.abs() < 0.05, "{s}");
     }
 }
+
+/// The hand-computed case of the registered 1-SSIM, run through its registry line.
+#[cfg(test)]
+pub(crate) mod hand {
+    use crate::film::linear_to_srgb;
+    use crate::metrics::{close, constant, run, Compute};
+
+    pub(crate) fn ssim_error(compute: Compute) {
+        // Constant images: SSIM is the luminance term (2 a b + C1) / (a^2 + b^2 + C1) of the
+        // tone-mapped values, C1 = (0.01)^2; 1-SSIM is reported.
+        let (a, b) = (linear_to_srgb(0.5), linear_to_srgb(0.25));
+        let c1 = 1e-4;
+        let want = 1.0 - (2.0 * a * b + c1) / (a * a + b * b + c1);
+        let (x, r) = (constant(12, 12, 0.5), constant(12, 12, 0.25));
+        close(run(compute, &x, &r, 0.01, 0.01), want, "1-ssim");
+        // A film smaller than the 11x11 window: the metric does not apply.
+        let (x, r) = (constant(4, 4, 0.5), constant(4, 4, 0.25));
+        assert_eq!(run(compute, &x, &r, 0.01, 0.01), None);
+    }
+}

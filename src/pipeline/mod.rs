@@ -7,7 +7,7 @@ pub mod shard;
 
 use crate::experiment::events;
 use crate::experiment::probe::{self, ProbeOutcome};
-use crate::experiment::{figures, load, results, run_experiment, Outcome, RunOptions};
+use crate::experiment::{figures, load, metric, run_experiment, Outcome, RunOptions};
 use crate::report::html::Viewer;
 use std::path::Path;
 
@@ -23,7 +23,7 @@ pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(),
 
 /// Writes the figures and report of a finished sweep and prints its summary.
 pub fn report_outcome(o: &Outcome, viewer: Viewer) -> Result<(), String> {
-    results::write_long(&o.dir.join("metrics.csv"), &o.rows)?;
+    metric::write_long(&o.dir.join("metrics.csv"), &o.rows)?;
     events::write_jsonl(&o.dir.join("results.jsonl"), &o.rows)?;
     let (series, mut figs) = figures::charts(o)?;
     figs.extend(figures::images(o)?);

@@ -17,12 +17,5 @@ pub(crate) const ALPHA: f64 = 1e-3;
 
 /// A render of `spp` independent samples per pixel with `seed`, on every core.
 pub(crate) fn settings(spp: u32, seed: u64) -> RenderSettings {
-    RenderSettings {
-        spp,
-        seed,
-        first_sample: 0,
-        threads: None,
-        progress: None,
-        sampling: Default::default(),
-    }
+    RenderSettings::new(spp, seed)
 }

@@ -58,6 +58,19 @@ impl std::fmt::Debug for Progress {
 }
 
 impl RenderSettings {
+    /// `spp` samples per pixel from `seed` (the first samples of each pixel's stream) with the
+    /// independent sampler, on every core, without progress.
+    pub fn new(spp: u32, seed: u64) -> Self {
+        RenderSettings {
+            spp,
+            seed,
+            first_sample: 0,
+            threads: None,
+            progress: None,
+            sampling: Sampling::default(),
+        }
+    }
+
     /// The sampler's configuration for this render, or why it cannot draw its samples.
     pub fn sampler_config(&self, film: (u32, u32)) -> Result<SamplerConfig, String> {
         self.sampling

@@ -74,30 +74,6 @@ impl<'a> Direct<'a> {
         }
     }
 
-    /// Radiance along a camera ray.
-    pub fn li(&self, ray: &Ray, rng: &mut impl Sampler) -> Rgb {
-        match self.scene.intersect(ray) {
-            Some(hit) => self.li_hit(ray, &hit.sp, rng),
-            None => Rgb::ZERO,
-        }
-    }
-
-    /// `li` given the camera ray's hit.
-    pub(super) fn li_hit(&self, ray: &Ray, sp: &SurfacePoint, rng: &mut impl Sampler) -> Rgb {
-        let scene = self.scene;
-        let mut l = Rgb::ZERO;
-        if !self.strategy.hide_emitters {
-            if let Some((_, e)) = scene.emitter_at(sp) {
-                l += e.le(sp, -ray.d);
-            }
-        }
-        let sh = self.shading(sp, ray.d);
-        // A delta BSDF gives light samples zero throughput: all its light arrives via BSDF
-        // samples, which then carry weight 1.
-        let delta_bsdf = sh.mat.is_delta();
-        super::strategies::li(self, &sh, delta_bsdf, rng, l)
-    }
-
     /// The weight of the pure strategies' fallback to the other technique, for the paths only
     /// it can produce (delta BSDFs for light sampling, delta lights for BSDF sampling): 1
     /// where the own technique's density is 0, else 0. Nothing is lost or counted twice.
@@ -116,7 +92,7 @@ impl<'a> Direct<'a> {
 
     /// The shading context of a camera ray of direction `d` that hit `sp`.
     #[inline(always)]
-    fn shading(&self, sp: &SurfacePoint, d: Vec3) -> Shading<'_> {
+    pub(super) fn shading(&self, sp: &SurfacePoint, d: Vec3) -> Shading<'_> {
         let frame = Frame::from_normal(sp.ns);
         Shading {
             sp: *sp,

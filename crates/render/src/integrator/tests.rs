@@ -43,14 +43,7 @@ pub(crate) fn image_z(out: &RenderOutput, expected: f64) -> (f64, f64) {
 }
 
 pub(crate) fn settings(spp: u32, seed: u64) -> RenderSettings {
-    RenderSettings {
-        spp,
-        seed,
-        first_sample: 0,
-        threads: None,
-        progress: None,
-        sampling: Default::default(),
-    }
+    RenderSettings::new(spp, seed)
 }
 
 #[test]

@@ -15,6 +15,7 @@ mod mis_onesample;
 
 use super::direct::{Direct, Shading};
 use super::Strategy;
+use crate::geometry::{Ray, SurfacePoint};
 use crate::math::Rgb;
 use crate::named::Named;
 use crate::sampler::Sampler;
@@ -74,6 +75,34 @@ estimators!(
     mis::Mis,
     mis_onesample::MisOneSample,
 );
+
+/// The entry points of the estimator: they dispatch to the strategies, so they live here,
+/// above the techniques of `direct.rs`.
+impl Direct<'_> {
+    /// Radiance along a camera ray.
+    pub fn li(&self, ray: &Ray, rng: &mut impl Sampler) -> Rgb {
+        match self.scene.intersect(ray) {
+            Some(hit) => self.li_hit(ray, &hit.sp, rng),
+            None => Rgb::ZERO,
+        }
+    }
+
+    /// `li` given the camera ray's hit.
+    pub(super) fn li_hit(&self, ray: &Ray, sp: &SurfacePoint, rng: &mut impl Sampler) -> Rgb {
+        let scene = self.scene;
+        let mut l = Rgb::ZERO;
+        if !self.strategy.hide_emitters {
+            if let Some((_, e)) = scene.emitter_at(sp) {
+                l += e.le(sp, -ray.d);
+            }
+        }
+        let sh = self.shading(sp, ray.d);
+        // A delta BSDF gives light samples zero throughput: all its light arrives via BSDF
+        // samples, which then carry weight 1.
+        let delta_bsdf = sh.mat.is_delta();
+        li(self, &sh, delta_bsdf, rng, l)
+    }
+}
 
 #[cfg(test)]
 mod tests {
