@@ -423,6 +423,18 @@ fn quick_fig4_crosses_samplers_and_reports_rates() {
         assert_eq!(cells[2] == "-", cells[3] == "-", "{row}");
     }
     assert!(rows.iter().any(|r| r.contains('[')), "{rates}");
+    // Every strategy against the first, with an interval over its 4 seeds.
+    let gains = &index[index.find("## Gains over").expect("gains table")..];
+    let gains = &gains[..gains[3..].find("\n## ").map_or(gains.len(), |i| i + 3)];
+    let gains: Vec<&str> = gains
+        .lines()
+        .filter(|l| l.starts_with("| ") && l.contains(", "))
+        .collect();
+    assert_eq!(gains.len(), 17, "every column but the first");
+    assert!(
+        gains.iter().all(|l| l.matches("x [").count() == 3),
+        "{gains:?}"
+    );
     std::fs::remove_dir_all(&out).unwrap();
 }
 

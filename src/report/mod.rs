@@ -5,6 +5,7 @@ pub mod html;
 mod means;
 pub mod probe;
 mod probe_table;
+pub(crate) mod ratios;
 pub(crate) mod tables;
 
 pub use means::{mean_check, mean_check_lines, Comparison, MEAN_ALPHA};
@@ -152,6 +153,7 @@ pub fn write_experiment(
     tables::metrics_table(&mut md, o);
     tables::diagnostics(&mut md, o, series);
     tables::equal_time_table(&mut md, o);
+    ratios::gains(&mut md, o);
     means::means(&mut md, o);
     tables::variance_table(&mut md, o);
     let _ = writeln!(md, "## Figures\n");
