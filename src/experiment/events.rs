@@ -116,6 +116,12 @@ impl Progress {
         self.bar.inc_length(samples);
     }
 
+    /// A run planned at `planned` samples rendered `actual` (an equal-time run re-timed).
+    pub fn replan(&mut self, planned: u64, actual: u64) {
+        self.total = self.total + actual - planned.min(self.total + actual);
+        self.bar.set_length(self.total);
+    }
+
     /// One run of `samples` camera samples finished.
     pub fn run_done(&mut self, samples: u64) {
         self.done += samples;

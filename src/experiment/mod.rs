@@ -5,6 +5,7 @@
 
 pub mod analysis;
 pub mod args;
+pub mod budget;
 pub mod cache;
 pub mod cases;
 pub mod chunks;

@@ -25,6 +25,7 @@ pub fn time_tag(budget: f64) -> String {
 }
 
 /// One render to do.
+#[derive(Clone)]
 pub(crate) struct Job {
     pub(crate) name: String,
     pub(crate) method: Method,
@@ -87,17 +88,6 @@ pub(crate) fn plan_sweep(results: &Results, kept: &[(String, Method)], sw: &Swee
         }
     }
     jobs
-}
-
-/// Samples per second of a strategy over its sweep rows (dominated by the long runs, where
-/// per-render overhead is negligible).
-pub(crate) fn rate(rows: &[Row], label: &str) -> Option<f64> {
-    let (mut samples, mut secs) = (0.0, 0.0);
-    for r in rows.iter().filter(|r| r.is_sweep() && r.strategy == label) {
-        samples += r.samples_per_s * r.seconds;
-        secs += r.seconds;
-    }
-    (secs > 0.0).then(|| samples / secs)
 }
 
 /// Loads a kept image and its variance.

@@ -1,13 +1,14 @@
 //! Running one experiment: scene, left-out analysis, cached reference, the (strategy, spp,
 //! seed) sweep and the equal-time runs, resuming from `results.csv`; then figures and report.
 
+use super::budget::{equal_time_spp, Retime};
 use super::cache::{self, Fnv, KeyInputs, Reference, ReferenceRequest};
 use super::events::{self, Progress};
 use super::leftout::{leave_out, Omission, SceneTraits};
 use super::measure::{measure, Extra};
 use super::method::{cross, Method};
 use super::plan::{
-    has_image, image_path, plan_sweep, rate, same_run, time_tag, variance_path, Job, Sweep,
+    has_image, image_path, plan_sweep, same_run, time_tag, variance_path, Job, Sweep,
 };
 use super::results::{Results, Row, EQUAL_TIME};
 use super::schema::{EqualTimeSpec, Resolved};
@@ -182,7 +183,6 @@ fn equal_time_jobs(
     kept: &[(String, Method)],
     results: &Results,
     dir: &Path,
-    pixels: u64,
 ) -> Result<Vec<Job>, String> {
     let mut timed = Vec::new();
     for &budget in &et.seconds {
@@ -198,7 +198,7 @@ fn equal_time_jobs(
                 // and the figure show the same render.
                 let spp = match old {
                     Some(r) => r.spp,
-                    None => equal_time_spp(&results.rows, &label, budget, pixels)?,
+                    None => equal_time_spp(&results.rows, &label, budget)?,
                 };
                 timed.push(Job {
                     name: name.clone(),
@@ -400,17 +400,6 @@ impl Outcome {
 }
 
 /// The spp that `budget` seconds buy `label` at the rate its sweep rows measured.
-pub(crate) fn equal_time_spp(
-    rows: &[Row],
-    label: &str,
-    budget: f64,
-    pixels: u64,
-) -> Result<u32, String> {
-    let r =
-        rate(rows, label).ok_or_else(|| format!("no sweep rows for {label} to time it from"))?;
-    Ok(((budget * r / pixels as f64).round() as u32).max(1))
-}
-
 pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, String> {
     let start = Instant::now();
     let s = setup(exp, opts)?;
@@ -453,25 +442,41 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
     );
     let mut bar = Progress::new(&exp.name, samples, runs);
     let mut rendered = 0;
-    let mut run = |job: &Job, results: &mut Results, bar: &mut Progress| -> Result<(), String> {
-        let row = execute(&ctx, job)?;
+    let mut commit = |row: Row, spp: u64, results: &mut Results, bar: &mut Progress| {
         results.rows.retain(|r| !same_run(r, &row));
-        bar.run_done(job.spp as u64 * pixels);
+        bar.run_done(spp * pixels);
         rendered += 1;
         events::result(&exp.name, &row);
         results.push_and_save(row, &csv)
     };
     for job in &jobs {
-        run(job, &mut results, &mut bar)?;
+        commit(execute(&ctx, job)?, job.spp as u64, &mut results, &mut bar)?;
     }
 
     let timed = match &x.equal_time {
-        Some(et) => equal_time_jobs(et, kept, &results, dir, pixels)?,
+        Some(et) => equal_time_jobs(et, kept, &results, dir)?,
         None => Vec::new(),
     };
     bar.add(timed.iter().map(|j| j.spp as u64 * pixels).sum());
+    let mut retime = Retime::default();
     for job in &timed {
-        run(job, &mut results, &mut bar)?;
+        // A row re-rendered for its missing image keeps its spp (and so its figure).
+        let fresh = results
+            .find_equal_time(&job.method.label(), job.budget, job.seed)
+            .is_none();
+        // The samples actually rendered: a re-timed run renders twice.
+        let mut spp = 0u64;
+        let row = if fresh {
+            retime.run(job, |j| {
+                spp += j.spp as u64;
+                execute(&ctx, j)
+            })?
+        } else {
+            spp = job.spp as u64;
+            execute(&ctx, job)?
+        };
+        bar.replan(job.spp as u64 * pixels, spp * pixels);
+        commit(row, spp, &mut results, &mut bar)?;
     }
     bar.finish();
     let near = results.rows.iter().filter(|r| r.near_floor).count();

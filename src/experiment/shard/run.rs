@@ -5,10 +5,11 @@ use super::merge::{merge_reference, stage_rows};
 use super::unitfile::{self, UnitResult};
 use super::units::{Stage, Unit};
 use super::{open, threads, Planned, ShardRef};
+use crate::experiment::budget::equal_time_spp;
 use crate::experiment::chunks::{render_chunk, Accum};
 use crate::experiment::plan::Job;
 use crate::experiment::results::{Row, EQUAL_TIME, SWEEP};
-use crate::experiment::runner::{equal_time_spp, render_job, Ctx, RefSource};
+use crate::experiment::runner::{render_job, Ctx, RefSource};
 use crate::experiment::RunOptions;
 use std::path::Path;
 use std::time::Instant;
@@ -115,12 +116,11 @@ pub fn run_shard(
                 } else {
                     Vec::new()
                 };
-                let pixels = p.s.pixels();
                 let p = &p;
                 Box::new(move |i| {
                     let u = &p.plan.units[i];
                     let spp = match stage {
-                        Stage::Timed => equal_time_spp(&rows, &u.strategy, u.budget, pixels)?,
+                        Stage::Timed => equal_time_spp(&rows, &u.strategy, u.budget)?,
                         _ => u.spp,
                     };
                     let ctx = Ctx {
