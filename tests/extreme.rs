@@ -179,6 +179,21 @@ fn quick_suite_through_the_cli_is_finite_unbiased_and_resumes() {
         "{index}"
     );
     assert!(index.contains("![relMSE against spp](convergence.png)"));
+    // Time and error at equal work per strategy, beside the error alone.
+    let header = index
+        .lines()
+        .find(|l| l.starts_with("| case | strategy | non-finite"))
+        .unwrap();
+    assert!(
+        header.contains("| ns / sample | relMSE x time |"),
+        "{header}"
+    );
+    let row = index
+        .lines()
+        .find(|l| l.starts_with("| tiny-bright | light-e1-uni-area | 0 |"))
+        .unwrap();
+    let ns: f64 = row.split('|').nth(7).unwrap().trim().parse().unwrap();
+    assert!(ns > 0.0 && ns < 1e6, "{row}");
     assert!(index.contains("0 biased"), "{index}");
     let png = std::fs::read(dir.join("convergence.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");

@@ -139,22 +139,31 @@ fn cases(md: &mut String, o: &ProbeOutcome) {
 
 fn results(md: &mut String, o: &ProbeOutcome, t: &[TableRow]) {
     let spp = table_spp(o);
-    let _ = writeln!(md, "## Results\n");
     let _ = writeln!(
         md,
-        "| case | strategy | non-finite | mean | z | relMSE@{spp} | max sample | top 0.1 % | slope | verdict |"
+        "## Results\n\nns / sample: the time one sample of the strategy's stream takes (mean over \
+         seeds); relMSE x time: relMSE at {spp} spp times the seconds those samples take per \
+         pixel, the error at equal work (lower is better), which charges a costly emitter \
+         choice (exhaustive is O(N)) for its time.\n"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        md,
+        "| case | strategy | non-finite | mean | z | relMSE@{spp} | ns / sample | relMSE x time | max sample | top 0.1 % | slope | verdict |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for r in t {
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {}{} |",
+            "| {} | {} | {} | {} | {:.2} | {} | {:.0} | {} | {} | {} | {} | {}{} |",
             r.case,
             r.label,
             r.non_finite,
             sci(r.mean),
             r.z,
             sci(r.relmse),
+            r.ns_per_sample,
+            // The error at equal work: relMSE at spp times the time those samples take.
+            sci(r.relmse * r.ns_per_sample * 1e-9 * spp as f64),
             sci(r.max_sample),
             if r.top_share.is_nan() {
                 "—".into()

@@ -24,6 +24,8 @@ pub struct TableRow {
     pub max_sample: f64,
     pub top_share: f64,
     pub slope: Option<f64>,
+    /// Time per sample, mean over seeds (the stream's draw, shading included).
+    pub ns_per_sample: f64,
     pub verdict: &'static str,
 }
 
@@ -114,6 +116,7 @@ fn pooled(o: &ProbeOutcome, c: &CaseRun, name: &str, label: &str) -> Option<Tabl
         max_sample: worst(|r| r.max_sample),
         top_share: worst(|r| r.top_share),
         slope,
+        ns_per_sample: per_seed.iter().map(|r| 1e9 / r.samples_per_s).sum::<f64>() / s,
         verdict: "",
     })
 }
