@@ -85,11 +85,14 @@ pub(crate) struct Retime {
 }
 
 impl Retime {
-    pub(crate) fn run(
+    /// Renders `job` (whose render's row is `row_of` of what `render` returns), once more if
+    /// it misses its budget.
+    pub(crate) fn run_with<T>(
         &mut self,
         job: &Job,
-        mut render: impl FnMut(&Job) -> Result<Row, String>,
-    ) -> Result<Row, String> {
+        mut render: impl FnMut(&Job) -> Result<T, String>,
+        row_of: impl Fn(&T) -> &Row,
+    ) -> Result<T, String> {
         let label = job.method.label();
         let at = self
             .factors
@@ -101,12 +104,12 @@ impl Retime {
             spp: scaled(factor),
             ..job.clone()
         };
-        let mut row = render(&j)?;
-        let miss = row.seconds / job.budget;
+        let mut out = render(&j)?;
+        let miss = row_of(&out).seconds / job.budget;
         let factor = if (miss - 1.0).abs() > BUDGET_TOLERANCE && miss > 0.0 {
             let f = factor / miss;
             j.spp = scaled(f);
-            row = render(&j)?;
+            out = render(&j)?;
             f
         } else {
             factor
@@ -115,7 +118,16 @@ impl Retime {
             Some(i) => self.factors[i].2 = factor,
             None => self.factors.push((label, job.budget, factor)),
         }
-        Ok(row)
+        Ok(out)
+    }
+
+    /// [`Retime::run_with`] of a render that returns its row.
+    pub(crate) fn run(
+        &mut self,
+        job: &Job,
+        render: impl FnMut(&Job) -> Result<Row, String>,
+    ) -> Result<Row, String> {
+        self.run_with(job, render, |r| r)
     }
 }
 

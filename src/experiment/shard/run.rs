@@ -5,7 +5,7 @@ use super::merge::{merge_reference, stage_rows};
 use super::unitfile::{self, UnitResult};
 use super::units::{Stage, Unit};
 use super::{open, threads, Planned, ShardRef};
-use crate::experiment::budget::equal_time_spp;
+use crate::experiment::budget::{equal_time_spp, Retime};
 use crate::experiment::chunks::{render_chunk, Accum};
 use crate::experiment::plan::Job;
 use crate::experiment::results::{Row, EQUAL_TIME, SWEEP};
@@ -131,7 +131,17 @@ pub fn run_shard(
                         context: p.s.context.clone(),
                         threads,
                     };
-                    let (row, out) = render_job(&ctx, &job_of(p, u, spp)?)?;
+                    let job = job_of(p, u, spp)?;
+                    // An equal-time unit that misses its budget is rendered once more (each
+                    // unit alone: no correction carries over from other seeds).
+                    let (row, out) = match stage {
+                        Stage::Timed => Retime::default().run_with(
+                            &job,
+                            |j| render_job(&ctx, j),
+                            |(row, _)| row,
+                        )?,
+                        _ => render_job(&ctx, &job)?,
+                    };
                     Ok(UnitResult {
                         row: Some(row),
                         accum: u.image.then(|| Accum::of(&out)),
