@@ -48,7 +48,7 @@ impl TypedValueParser for EmitterSelectionParser {
     fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
         let rules = crate::emitter::RULES
             .iter()
-            .map(|r| PossibleValue::new(r.1).help(r.3));
+            .map(|r| PossibleValue::new(r.name).help(r.help));
         let ris = PossibleValue::new("ris:M").help(format!(
             "resampling of M candidates drawn by power, M from 1 to {}",
             crate::emitter::RIS_MAX

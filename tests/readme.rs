@@ -38,7 +38,7 @@ fn render_options_list_the_registered_values() {
     assert_eq!(listed(&r, "--light-sampling"), names::<LightSampling>());
     assert_eq!(listed(&r, "--sampler"), names::<SamplerKind>());
     assert_eq!(listed(&r, "--dims"), names::<DimAlloc>());
-    let mut rules: Vec<String> = RULES.iter().map(|r| r.1.to_string()).collect();
+    let mut rules: Vec<String> = RULES.iter().map(|r| r.name.to_string()).collect();
     rules.push("ris:M".into());
     assert_eq!(listed(&r, "--emitter-selection"), rules);
 }
@@ -79,7 +79,7 @@ fn the_command_line_lists_and_checks_the_registered_values() {
     let help = String::from_utf8_lossy(&help.stdout).to_string();
     for r in RULES {
         assert!(
-            help.contains(&format!("- {}:", r.1)) && help.contains(r.3),
+            help.contains(&format!("- {}:", r.name)) && help.contains(r.help),
             "{help}"
         );
     }

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 /// Every registered emitter-choice rule.
 fn rules() -> Vec<EmitterSelection> {
-    crate::emitter::RULES.iter().map(|r| r.0).collect()
+    crate::emitter::RULES.iter().map(|r| r.value).collect()
 }
 
 /// The choices timed per run: 2^20, or fewer where a choice visits every emitter (about

@@ -263,7 +263,7 @@ fn point_choices() -> Vec<Case> {
     let mut out = Vec::new();
     let at_point = crate::emitter::RULES
         .iter()
-        .map(|r| r.0)
+        .map(|r| r.value)
         .filter(|r| r.at_point());
     for selection in at_point {
         for (view, p, n) in points {
@@ -322,8 +322,8 @@ pub fn cases() -> Vec<Case> {
         // Every registered rule blind to the shading point; the others at points below.
         crate::emitter::RULES
             .iter()
-            .filter(|r| !r.0.at_point())
-            .map(|r| emitter_choice(r.0)),
+            .filter(|r| !r.value.at_point())
+            .map(|r| emitter_choice(r.value)),
     )
     .chain([triangle_choice()])
     .chain(point_choices())

@@ -515,15 +515,15 @@ fn selections_parse_and_name_themselves() {
     assert!(EmitterSelection::Bvh.at_point() && !EmitterSelection::Ris(4).at_point());
     // Every registered rule: a unique name and short form that parse back, and help.
     for (i, r) in RULES.iter().enumerate() {
-        assert_eq!(r.1.parse::<EmitterSelection>(), Ok(r.0));
+        assert_eq!(r.name.parse::<EmitterSelection>(), Ok(r.value));
         assert_eq!(
-            (r.0.name(), r.0.short()),
-            (r.1.to_string(), r.2.to_string())
+            (r.value.name(), r.value.short()),
+            (r.name.to_string(), r.short.to_string())
         );
-        assert!(!r.3.is_empty());
+        assert!(!r.help.is_empty());
         assert!(RULES[..i]
             .iter()
-            .all(|o| o.1 != r.1 && o.2 != r.2 && o.0 != r.0));
+            .all(|o| o.name != r.name && o.short != r.short && o.value != r.value));
     }
     assert!(rules().len() > RULES.len(), "RIS is checked too");
 }

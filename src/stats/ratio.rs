@@ -9,6 +9,7 @@
 //! uncertainty of the spread itself, and `tests::the_interval_covers_a_known_ratio`
 //! measures its coverage.
 
+use super::slope::quantile;
 use crate::rng::Rng;
 
 /// Bootstrap resamplings per interval.
@@ -66,14 +67,6 @@ fn mean(x: &[f64], pick: impl Iterator<Item = usize>) -> f64 {
         n += 1;
     }
     s / n as f64
-}
-
-/// Linear interpolation between order statistics (type 7) of sorted `x`.
-fn quantile(x: &[f64], q: f64) -> f64 {
-    let h = (x.len() - 1) as f64 * q.clamp(0.0, 1.0);
-    let (i, f) = (h.floor() as usize, h - h.floor());
-    let j = (i + 1).min(x.len() - 1);
-    x[i] + f * (x[j] - x[i])
 }
 
 /// mean(a) / mean(b) with its 95 % bootstrap-t interval (`draws` resamplings, a fixed

@@ -66,7 +66,7 @@ pub fn bootstrap_slope(points: &[SeedErrors], draws: usize) -> Option<(f64, f64)
 }
 
 /// Linear interpolation between order statistics (type 7, R's default) of sorted `x`.
-fn quantile(x: &[f64], q: f64) -> f64 {
+pub(crate) fn quantile(x: &[f64], q: f64) -> f64 {
     let h = (x.len() - 1) as f64 * q;
     let (i, f) = (h.floor() as usize, h - h.floor());
     let j = (i + 1).min(x.len() - 1);

@@ -9,7 +9,7 @@ mod tree;
 pub use area::AreaLight;
 pub(crate) use area::{area_pdf_along, sample_at, sphere_area_point};
 pub use bounds::{Cone, LightBounds};
-pub use select::{EmitterSelection, EmitterSelector, RIS_MAX, RULES};
+pub use select::{EmitterSelection, EmitterSelector, RuleInfo, RIS_MAX, RULES};
 
 use crate::geometry::{Shape, SurfacePoint};
 use crate::math::{luminance, Rgb, PI};

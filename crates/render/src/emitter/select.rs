@@ -26,9 +26,13 @@ macro_rules! rules {
             Ris(u32),
         }
 
-        /// Every registered rule: its value, name, short form in labels and help.
-        pub const RULES: &[(EmitterSelection, &str, &str, &str)] =
-            &[$((EmitterSelection::$variant, $name, $short, $help),)*];
+        /// Every registered rule.
+        pub const RULES: &[RuleInfo] = &[$(RuleInfo {
+            value: EmitterSelection::$variant,
+            name: $name,
+            short: $short,
+            help: $help,
+        },)*];
 
         #[derive(Clone, Debug)]
         enum Rule {
@@ -105,18 +109,32 @@ rules! {
         "a light tree (pbrt-v4's BVH light sampler): O(log N) per choice";
 }
 
+/// A registered rule: its value, the name the CLI and experiment files use, its short form
+/// in strategy labels and a line of help.
+#[derive(Clone, Copy, Debug)]
+pub struct RuleInfo {
+    /// The value.
+    pub value: EmitterSelection,
+    /// Its name.
+    pub name: &'static str,
+    /// Its short form in labels.
+    pub short: &'static str,
+    /// What it is.
+    pub help: &'static str,
+}
+
 /// The largest RIS candidate count.
 pub const RIS_MAX: u32 = 256;
 
 impl EmitterSelection {
-    fn row(self) -> Option<&'static (EmitterSelection, &'static str, &'static str, &'static str)> {
-        RULES.iter().find(|r| r.0 == self)
+    fn row(self) -> Option<&'static RuleInfo> {
+        RULES.iter().find(|r| r.value == self)
     }
 
     /// The name the CLI and experiment files use.
     pub fn name(self) -> String {
         match (self, self.row()) {
-            (_, Some(r)) => r.1.into(),
+            (_, Some(r)) => r.name.into(),
             (EmitterSelection::Ris(m), None) => format!("ris:{m}"),
             _ => unreachable!("every rule has a row in RULES"),
         }
@@ -125,7 +143,7 @@ impl EmitterSelection {
     /// The short form in strategy labels.
     pub fn short(self) -> String {
         match (self, self.row()) {
-            (_, Some(r)) => r.2.into(),
+            (_, Some(r)) => r.short.into(),
             (EmitterSelection::Ris(m), None) => format!("ris{m}"),
             _ => unreachable!("every rule has a row in RULES"),
         }
@@ -144,7 +162,7 @@ impl EmitterSelection {
     pub fn every() -> Vec<EmitterSelection> {
         RULES
             .iter()
-            .map(|r| r.0)
+            .map(|r| r.value)
             .chain([EmitterSelection::Ris(1), EmitterSelection::Ris(8)])
             .collect()
     }
@@ -160,15 +178,15 @@ impl std::str::FromStr for EmitterSelection {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         let s = s.trim();
-        if let Some(r) = RULES.iter().find(|r| r.1 == s) {
-            return Ok(r.0);
+        if let Some(r) = RULES.iter().find(|r| r.name == s) {
+            return Ok(r.value);
         }
         s.strip_prefix("ris:")
             .and_then(|m| m.parse::<u32>().ok())
             .filter(|m| (1..=RIS_MAX).contains(m))
             .map(EmitterSelection::Ris)
             .ok_or_else(|| {
-                let names: Vec<&str> = RULES.iter().map(|r| r.1).collect();
+                let names: Vec<&str> = RULES.iter().map(|r| r.name).collect();
                 format!(
                     "unknown emitter selection '{s}': expected {} or ris:M with M from 1 to \
                      {RIS_MAX}",

@@ -55,12 +55,11 @@ macro_rules! estimators {
         /// The strategy's stable label (see [`Strategy::label`]).
         pub(super) fn label(s: &Strategy) -> String {
             let (h, sel, ls) = (s.heuristic.short(), s.selection.short(), s.light_sampling.short());
-            let rest = [$((<$ty as Estimator>::KIND, <$ty as Estimator>::label as fn(&Strategy, &str, &str, &str) -> String)),*]
-                .into_iter()
-                .find(|(k, _)| *k == s.kind)
-                .map(|(_, f)| f(s, h, &sel, ls))
-                .expect("every strategy has an estimator (registry tests)");
-            format!("{}-{rest}", s.kind.short())
+            $(if s.kind == <$ty as Estimator>::KIND {
+                let rest = <$ty as Estimator>::label(s, h, &sel, ls);
+                return format!("{}-{rest}", s.kind.short());
+            })*
+            unreachable!("every strategy has an estimator (registry tests)")
         }
 
         /// The strategies with an estimator, in registration order.
