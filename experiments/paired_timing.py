@@ -9,7 +9,9 @@ won, and the best of each. The last pair's images are compared byte for byte, si
 render-loop changes are meant to leave them identical.
 
     python3 experiments/paired_timing.py OLD_BINARY NEW_BINARY [--pairs 16] [--scene cbox]
-        [-- extra render arguments]
+        [--strategy "--strategy light"] [-- extra render arguments]
+
+The strategy defaults to power MIS with one sample per technique and power emitter choice.
 
 Build the baseline from a worktree (git worktree add /tmp/base COMMIT; cargo build --release
 there) so that both binaries use the same flags.
@@ -19,6 +21,7 @@ import argparse
 import filecmp
 import os
 import re
+import shlex
 import statistics
 import subprocess
 import sys
@@ -34,7 +37,7 @@ STRATEGY = ["--strategy", "mis", "--heuristic", "power", "--emitter-selection", 
 
 def render(binary, args, out):
     """Samples per second of one 1-thread render, as the renderer reports it."""
-    cmd = [binary, "render", *args, "--threads", "1", *STRATEGY, "--out", out]
+    cmd = [binary, "render", *args, "--threads", "1", "--out", out]
     run = subprocess.run(cmd, capture_output=True, text=True)
     text = run.stdout + run.stderr
     if run.returncode != 0:
@@ -51,6 +54,8 @@ def main():
     ap.add_argument("b", help="candidate binary")
     ap.add_argument("--pairs", type=int, default=16)
     ap.add_argument("--scene", choices=sorted(SCENES), default="cbox")
+    ap.add_argument("--strategy", default=shlex.join(STRATEGY),
+                    help="the strategy's render arguments, as one string")
     argv = sys.argv[1:]
     cut = argv.index("--") if "--" in argv else len(argv)
     a = ap.parse_args(argv[:cut])
@@ -58,7 +63,7 @@ def main():
     for binary in (a.a, a.b):
         if not (os.path.isfile(binary) and os.access(binary, os.X_OK)):
             sys.exit(f"{binary}: not an executable file (expected a directlab binary)")
-    args = SCENES[a.scene] + extra
+    args = SCENES[a.scene] + shlex.split(a.strategy) + extra
     ratios, best = [], {"a": 0.0, "b": 0.0}
     with tempfile.TemporaryDirectory() as tmp:
         outs = {k: os.path.join(tmp, f"{k}.exr") for k in "ab"}

@@ -307,8 +307,13 @@ pub fn render_rows(
 
 /// Renders `scene` with `strategy`: every pixel's mean and variance of the mean.
 pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> RenderOutput {
+    render_with(&LaneKernel::new(scene, strategy), settings)
+}
+
+/// `render` with the estimator `kernel` (its scene and strategy).
+pub(crate) fn render_with(kernel: &LaneKernel, settings: &RenderSettings) -> RenderOutput {
+    let scene = kernel.direct.scene;
     let (w, h) = (scene.camera.width, scene.camera.height);
-    let kernel = LaneKernel::new(scene, strategy);
     let cfg = settings
         .sampler_config((w, h))
         .expect("sampler settings checked by the caller");
@@ -335,7 +340,7 @@ pub fn render(scene: &Scene, strategy: Strategy, settings: &RenderSettings) -> R
                 let mut scratch = LaneScratch::default();
                 for y in y0..(y0 + TILE).min(h) {
                     for x in x0..(x0 + TILE).min(w) {
-                        let r = render_any_pixel(&kernel, x, y, settings, &cfg, &mut scratch);
+                        let r = render_any_pixel(kernel, x, y, settings, &cfg, &mut scratch);
                         out.push((x, y, r));
                     }
                 }

@@ -33,16 +33,13 @@ impl LanesVisitor for PerSample<'_> {
     }
 }
 
-/// Renders `scene` and recomputes every pixel from its definition: the sampler's sample
-/// (for `independent`, generator `for_sample(seed, pixel, s)`), `generate_ray`, `li`, one
-/// sample at a time. The first pixel
-/// whose mean or variance differs in any bit is the error; otherwise the count of lit pixels.
-fn per_sample_mismatch(
-    scene: &Scene,
-    strategy: Strategy,
-    settings: &RenderSettings,
-) -> Result<u32, String> {
-    let out = render(scene, strategy, settings);
+/// Renders with `kernel` and recomputes every pixel from its definition: the sampler's
+/// sample (for `independent`, generator `for_sample(seed, pixel, s)`), `generate_ray`, `li`,
+/// one sample at a time. The first pixel whose mean or variance differs in any bit is the
+/// error; otherwise the count of lit pixels.
+fn per_sample_mismatch(kernel: &LaneKernel, settings: &RenderSettings) -> Result<u32, String> {
+    let out = render_with(kernel, settings);
+    let (scene, strategy) = (kernel.direct.scene, kernel.direct.strategy);
     let direct = crate::integrator::Direct::new(scene, strategy);
     let cam = &scene.camera;
     let cfg = settings.sampler_config((cam.width, cam.height))?;
@@ -78,11 +75,11 @@ fn per_sample_mismatch(
     Ok(lit)
 }
 
-/// The render loop starts samples eight at a time and, where `LaneKernel::li_lanes` covers
-/// the scene, shades them eight at a time; every pixel must still be exactly the
-/// per-sample definition: generator `for_sample(seed, pixel, s)`, `generate_ray`, `li`.
-/// spp 11 leaves a partial batch of three. Each case states whether the lanes cover it,
-/// so a change that quietly sends a covered case to the scalar path fails here too.
+/// The render loop starts samples eight at a time and `LaneKernel::li_lanes` shades them
+/// eight at a time; every pixel must still be exactly the per-sample definition: generator
+/// `for_sample(seed, pixel, s)`, `generate_ray`, `li`. spp 11 leaves a partial batch of
+/// three. Every case must shade batches in lanes, and most of its hits there, so a change
+/// that quietly sends a case to the scalar path fails here too.
 #[test]
 fn lane_samples_are_bitwise_the_per_sample_definition() {
     use crate::scene::desc::{FilterDesc, SceneDesc};
@@ -142,18 +139,21 @@ fn lane_samples_are_bitwise_the_per_sample_definition() {
             }
         }
     };
+    let with = |kind, e, b, light_sampling| Strategy {
+        kind,
+        emitter_samples: e,
+        bsdf_samples: b,
+        light_sampling,
+        ..power
+    };
+    use crate::emitter::LightSampling::{Area, SolidAngle};
     type Edit = dyn Fn(&mut SceneDesc);
-    let cases: [(&str, &Edit, crate::integrator::Strategy, bool); 10] = [
-        ("cbox/cbox.xml", &keep, mis, true),
+    let cases: [(&str, &Edit, crate::integrator::Strategy); 16] = [
+        ("cbox/cbox.xml", &keep, mis),
         // A light mesh of many triangles: the lanes' per-triangle records.
-        ("cbox-meshlight/cbox-meshlight.xml", &keep, power, true),
+        ("cbox-meshlight/cbox-meshlight.xml", &keep, power),
         // The same with vertex normals: the lanes' smooth light points.
-        (
-            "cbox-meshlight/cbox-meshlight.xml",
-            &smooth_light,
-            power,
-            true,
-        ),
+        ("cbox-meshlight/cbox-meshlight.xml", &smooth_light, power),
         (
             "cbox/cbox.xml",
             &keep,
@@ -161,22 +161,48 @@ fn lane_samples_are_bitwise_the_per_sample_definition() {
                 hide_emitters: true,
                 ..power
             },
-            true,
         ),
-        ("cbox-twolights/cbox-twolights.xml", &keep, power, true),
-        // Rough, smooth and two-sided materials: those hits take the scalar path.
+        ("cbox-twolights/cbox-twolights.xml", &keep, power),
+        // Rough, smooth and two-sided materials: delta hits take the scalar path.
+        ("cbox-materials/cbox-materials.xml", &no_point_lights, power),
+        // With its point lights, drawn lane by lane.
+        ("cbox-materials/cbox-materials.xml", &keep, power),
+        ("veach-mis/veach-mis.xml", &tent, mis),
+        ("veach-mis/veach-mis.xml", &rough_plates, power),
+        ("veach-mis/veach-mis.xml", &grey_plates, power),
+        // The other estimators and solid-angle sampling.
+        (
+            "cbox/cbox.xml",
+            &keep,
+            with(StrategyKind::Light, 1, 1, Area),
+        ),
         (
             "cbox-materials/cbox-materials.xml",
-            &no_point_lights,
-            power,
-            true,
+            &keep,
+            with(StrategyKind::Bsdf, 1, 2, Area),
         ),
-        ("cbox-materials/cbox-materials.xml", &keep, power, false),
-        ("veach-mis/veach-mis.xml", &tent, mis, true),
-        ("veach-mis/veach-mis.xml", &rough_plates, power, true),
-        ("veach-mis/veach-mis.xml", &grey_plates, power, true),
+        (
+            "cbox-materials/cbox-materials.xml",
+            &keep,
+            with(StrategyKind::Light, 2, 1, SolidAngle),
+        ),
+        (
+            "cbox-twolights/cbox-twolights.xml",
+            &keep,
+            with(StrategyKind::Mis, 2, 3, SolidAngle),
+        ),
+        (
+            "veach-mis/veach-mis.xml",
+            &keep,
+            with(StrategyKind::MisOneSample, 1, 1, Area),
+        ),
+        (
+            "veach-mis/veach-mis.xml",
+            &keep,
+            with(StrategyKind::MisOneSample, 2, 1, SolidAngle),
+        ),
     ];
-    for (rel, edit, strategy, lanes) in cases {
+    for (rel, edit, strategy) in cases {
         let mut desc = crate::scene::bundled_tests::load(rel);
         (desc.film.width, desc.film.height) = (12, 9);
         edit(&mut desc);
@@ -190,38 +216,42 @@ fn lane_samples_are_bitwise_the_per_sample_definition() {
             sampling: Default::default(),
         };
         let kernel = LaneKernel::new(&scene, strategy);
-        assert_eq!(kernel.has_lanes(), lanes, "{rel}: lane coverage");
-        let lit = per_sample_mismatch(&scene, strategy, &settings)
-            .unwrap_or_else(|e| panic!("{rel}: {e}"));
+        let lit = per_sample_mismatch(&kernel, &settings)
+            .unwrap_or_else(|e| panic!("{rel} {strategy:?}: {e}"));
         let cam = &scene.camera;
         assert!(lit > cam.width * cam.height / 2, "{rel}: {lit} lit pixels");
+        let paths: std::collections::BTreeMap<_, _> = kernel.paths.counts().into_iter().collect();
+        let batches = paths["uniform batch"] + paths["mixed batch"];
+        assert!(
+            batches * 8 > 4 * paths["scalar lane"],
+            "{rel} {strategy:?}: most hits in lanes, {paths:?}"
+        );
     }
 }
 
-/// The strategies the lanes cover: multi-sample MIS with one sample per technique and area
-/// sampling, with either heuristic, every emitter choice (RIS over one and four candidates),
-/// emitters shown or hidden.
-fn lane_strategies() -> Vec<Strategy> {
+/// Every estimator configuration: each registered strategy with either heuristic, one or
+/// several samples per technique, every emitter choice (RIS over one and eight candidates),
+/// every light sampling mode, emitters shown or hidden.
+fn configurations() -> Vec<Strategy> {
     let mut v = Vec::new();
-    for heuristic in [Heuristic::Balance, Heuristic::Power] {
-        for selection in [
-            EmitterSelection::Uniform,
-            EmitterSelection::Power,
-            EmitterSelection::Exhaustive,
-            EmitterSelection::Bvh,
-            EmitterSelection::Ris(1),
-            EmitterSelection::Ris(4),
-        ] {
-            for hide_emitters in [false, true] {
-                v.push(Strategy {
-                    kind: StrategyKind::Mis,
-                    heuristic,
-                    emitter_samples: 1,
-                    bsdf_samples: 1,
-                    selection,
-                    light_sampling: crate::emitter::LightSampling::Area,
-                    hide_emitters,
-                });
+    for kind in StrategyKind::all() {
+        for heuristic in Heuristic::all() {
+            for (emitter_samples, bsdf_samples) in [(1, 1), (2, 1), (1, 2), (2, 3)] {
+                for selection in EmitterSelection::every() {
+                    for light_sampling in crate::emitter::LightSampling::all() {
+                        for hide_emitters in [false, true] {
+                            v.push(Strategy {
+                                kind,
+                                heuristic,
+                                emitter_samples,
+                                bsdf_samples,
+                                selection,
+                                light_sampling,
+                                hide_emitters,
+                            });
+                        }
+                    }
+                }
             }
         }
     }
@@ -243,21 +273,15 @@ fn random_scenes_render_bitwise_as_their_per_sample_definition() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(48);
     let dir = std::env::temp_dir().join(format!("directlab-random-{}", std::process::id()));
-    let covered = lane_strategies();
-    let all = Strategy::combinations();
+    let all = configurations();
     let mut seen: BTreeMap<String, u32> = BTreeMap::new();
     let mut tally = |what: String| *seen.entry(what).or_default() += 1;
     for seed in 0..cases {
         let r = random_scene(seed, &dir);
         let mut pick = Rng::new(seed, 77);
-        let strategy = match pick.next_f32() < 0.85 {
-            true => covered[(pick.next_u32() as usize) % covered.len()],
-            false => all[(pick.next_u32() as usize) % all.len()],
-        };
+        let strategy = all[(pick.next_u32() as usize) % all.len()];
         let scene = Scene::build(r.desc).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
         let kernel = LaneKernel::new(&scene, strategy);
-        let want = covered.contains(&strategy) && r.features.point_lights == 0;
-        assert_eq!(kernel.has_lanes(), want, "seed {seed}: lane coverage");
         // Every sampler and allocation: the lanes draw each sample's numbers as the scalar
         // path does.
         let sampling = crate::sampler::Sampling {
@@ -282,14 +306,22 @@ fn random_scenes_render_bitwise_as_their_per_sample_definition() {
             progress: None,
             sampling,
         };
-        let lit = per_sample_mismatch(&scene, strategy, &settings)
+        let lit = per_sample_mismatch(&kernel, &settings)
             .unwrap_or_else(|e| panic!("seed {seed} ({strategy:?}): {e}"));
-        if !want {
-            tally("scalar".into());
-            continue;
-        }
         tally("lanes".into());
+        for (path, n) in kernel.paths.counts() {
+            if n > 0 {
+                tally(format!("path {path}"));
+            }
+        }
+        tally(format!("strategy {}", strategy.kind.name()));
         tally(format!("heuristic {:?}", strategy.heuristic));
+        let several = (strategy.emitter_samples, strategy.bsdf_samples) != (1, 1);
+        tally(format!("several samples {several}"));
+        tally(format!("light sampling {}", strategy.light_sampling.name()));
+        if r.features.point_lights > 0 {
+            tally("point lights".into());
+        }
         tally(format!("selection {:?}", strategy.selection));
         tally(format!("hide_emitters {}", strategy.hide_emitters));
         if lit > 0 {
@@ -318,21 +350,29 @@ fn random_scenes_render_bitwise_as_their_per_sample_definition() {
     let _ = std::fs::remove_dir_all(&dir);
     // What the seeds must have sent through the lanes, for the test to be about them.
     let mut want = vec![
-        "scalar".to_string(),
-        "heuristic Balance".into(),
+        "heuristic Balance".to_string(),
         "heuristic Power".into(),
-        "selection Uniform".into(),
-        "selection Power".into(),
-        "selection Exhaustive".into(),
-        "selection Bvh".into(),
-        "selection Ris(1)".into(),
-        "selection Ris(4)".into(),
+        "several samples true".into(),
+        "several samples false".into(),
+        "point lights".into(),
         "hide_emitters true".into(),
         "hide_emitters false".into(),
         "smooth receiver".into(),
         "lights over 8".into(),
         "lights up to 8".into(),
     ];
+    for path in crate::integrator::Paths::NAMES {
+        want.push(format!("path {path}"));
+    }
+    for kind in StrategyKind::all() {
+        want.push(format!("strategy {}", kind.name()));
+    }
+    for ls in crate::emitter::LightSampling::all() {
+        want.push(format!("light sampling {}", ls.name()));
+    }
+    for s in EmitterSelection::every() {
+        want.push(format!("selection {s:?}"));
+    }
     for kind in crate::sampler::SamplerKind::all() {
         for dims in ["joint", "padded"] {
             want.push(format!("sampler {} {dims}", kind.name()));

@@ -86,6 +86,7 @@ impl<'a> Direct<'a> {
     }
 
     /// Whether the scene has delta (point) lights, which BSDF samples never hit.
+    #[inline(always)]
     pub(super) fn has_delta_lights(&self) -> bool {
         self.has_delta_lights
     }
@@ -122,7 +123,7 @@ impl<'a> Direct<'a> {
         if let Some(m) = self.ris {
             return self.ris_draw(sh, rng, m).map(|(d, _)| d);
         }
-        let (ls, pmf) = self.candidate(sh, rng.light())?;
+        let (ls, pmf) = self.candidate(&sh.sp, rng.light())?;
         Some(LightDraw {
             ls,
             pmf,
@@ -130,14 +131,14 @@ impl<'a> Direct<'a> {
         })
     }
 
-    /// An emitter chosen at the shading point and a point drawn on it, with numbers `u`.
+    /// An emitter chosen at the shading point `sp` and a point drawn on it, with numbers `u`.
     #[inline(always)]
-    fn candidate(&self, sh: &Shading, u: LightDims) -> Option<(LightSample, f32)> {
+    pub(super) fn candidate(&self, sp: &SurfacePoint, u: LightDims) -> Option<(LightSample, f32)> {
         let scene = self.scene;
-        let (ei, pmf) = self.selector.sample(sh.sp.p, sh.sp.ns, u.select)?;
+        let (ei, pmf) = self.selector.sample(sp.p, sp.ns, u.select)?;
         let ls = scene.emitters[ei].sample(
             &scene.shapes,
-            sh.sp.p,
+            sp.p,
             u.primitive,
             u.point,
             self.strategy.light_sampling,
@@ -165,7 +166,7 @@ impl<'a> Direct<'a> {
         let mut kept: Option<(LightSample, f32, f32, LightDims)> = None;
         for _ in 0..m {
             let dims = rng.light();
-            let Some((ls, pmf)) = self.candidate(sh, dims) else {
+            let Some((ls, pmf)) = self.candidate(&sh.sp, dims) else {
                 continue;
             };
             let (f, _) = sh.mat.eval_pdf(sh.wi, sh.frame.to_local(ls.wi));

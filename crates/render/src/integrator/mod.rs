@@ -8,6 +8,8 @@ mod strategies;
 mod strategy;
 
 pub use direct::Direct;
+#[cfg(test)]
+pub(crate) use lanes::Paths;
 pub use lanes::{LaneKernel, LaneScratch};
 pub use strategy::{Strategy, StrategyOverrides};
 

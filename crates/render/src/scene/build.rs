@@ -369,13 +369,21 @@ impl Scene {
     /// The shadow ray `visible` traces (unnormalised direction, t in [0, 1 - 1e-4]).
     #[inline]
     pub fn shadow_ray(&self, from: &SurfacePoint, ls: &LightSample) -> Ray {
+        let (o, target) = Scene::shadow_ends(from, ls);
+        Scene::shadow_ray_to(o, target, self.accel.skip_id(from))
+    }
+
+    /// The ends of `shadow_ray`: its origin off `from`, and its target off the light (at a
+    /// delta light, the light's point).
+    #[inline(always)]
+    pub fn shadow_ends(from: &SurfacePoint, ls: &LightSample) -> (glam::Vec3, glam::Vec3) {
         let o = from.spawn_origin(ls.p - from.p);
         let target = if ls.delta {
             ls.p
         } else {
             offset_origin(ls.p, ls.ng, ls.err_scale, o - ls.p)
         };
-        Scene::shadow_ray_to(o, target, self.accel.skip_id(from))
+        (o, target)
     }
 
     /// The shadow ray from origin `o` to `target`, both already off their surfaces.

@@ -188,6 +188,9 @@ impl LightDraws {
             // hit draws from garbage and is dropped).
             let sp = at.point(i);
             let Some((e, pmf)) = selector.sample(sp.p, sp.ns, u_emitter[i]) else {
+                // No emitter chosen (`li` adds nothing): zero radiance leaves the lane's
+                // light sample out, whatever an earlier draw left in the other fields.
+                d.radiance.set(i, Rgb::ZERO);
                 continue;
             };
             let light = &lights[e];
@@ -218,7 +221,7 @@ pub(super) fn light_sample<const SPHERES: bool>(
     p: Vec3,
     ld: &LightDraws,
     sd: &SphereDraws,
-    u: &[[f32; LANES]; 7],
+    u: &[[f32; LANES]; 4],
     i: usize,
 ) -> (bool, Vec3, f32, Rgb, SurfacePoint) {
     let u_point = Vec2::new(u[2][i], u[3][i]);

@@ -2,28 +2,36 @@
 //! vector lanes. `LaneKernel` wraps the scalar estimator (`Direct`) and never restates it.
 //!
 //! The camera rays and the shadow rays of the eight samples are made and traced as packets,
-//! one array per component (`RayPacket`, see `geometry::packet`), the BSDF rays one at a
-//! time. Everything between them (shading frames, light points, densities, BSDF values, MIS
-//! weights, the shadow and BSDF rays) runs as loops over the eight samples, in
-//! structure-of-arrays form, which the compiler turns into vector code. Each loop body calls
-//! the scalar code `Direct::li` calls, in the same order, so every sample is bitwise what
-//! `li` gives it (`render_lanes_tests` checks this on random scenes).
+//! one array per component (`RayPacket`, see `geometry::packet`), the BSDF rays through a
+//! reject in lanes and then one at a time. Everything between them (shading frames, light
+//! points, densities, BSDF values, MIS weights, the shadow and BSDF rays) runs as loops over
+//! the eight samples, in structure-of-arrays form, which the compiler turns into vector code.
 //!
-//! There is one shading function (`shade`), generic over the BSDF type through the lane
+//! The estimators are not restated here: each is written once against
+//! `strategies::Techniques`, which `Direct` implements for one hit and `shade::Lanes` for the
+//! covered lanes of a batch (a light sample, a BSDF sample, both, or a per-lane choice of
+//! technique, each for a mask of lanes). Each step's loop body calls the scalar code
+//! `Direct`'s technique calls, in the same order, so every sample is bitwise what `li` gives
+//! it (`render_lanes_tests` checks this on random scenes, for every strategy).
+//!
+//! There is one shading function per technique, generic over the BSDF type through the lane
 //! methods of `Bsdf` (`lane_shared`, `eval_pdf_shared`, `sample_lanes`), whose defaults call
 //! the BSDF's own eval, pdf and sample lane by lane: a new BSDF runs in lanes as registered.
 //!
-//! What runs in lanes (the rule `tables::lane_setup` and `camera_hits` apply):
-//! - strategy: MIS with one light and one BSDF sample (balance or power heuristic; every
-//!   emitter choice, the point-dependent ones at each lane's hit; RIS's candidates drawn lane
-//!   by lane with `li`'s own draw, `ris_numbers`), area sampling, every emitter an area light
-//!   on a mesh or a sphere. Other strategies (light or BSDF only, N+M samples, one-sample
-//!   MIS, solid-angle sampling) and scenes with point lights render every sample with `li`;
+//! What runs in lanes: everything.
+//! - strategy: every registered estimator (light or BSDF sampling alone, MIS with N light
+//!   and M BSDF samples under either heuristic, one-sample MIS), every emitter choice (the
+//!   point-dependent ones at each lane's hit; RIS's candidates drawn lane by lane with `li`'s
+//!   own draw, `ris_numbers`), every sampler;
+//! - lights: area sampling of mesh and sphere lights reads the lane tables (`tables`) for
+//!   eight lanes at once; solid-angle sampling, point lights and any emitter the tables do
+//!   not hold draw each lane's light with `Direct::candidate` inside the lane loop;
 //! - per batch of eight hits: every registered BSDF that is not all-delta (diffuse, rough
 //!   conductor, Nori's microfacet, plastic, rough plastic; one- or two-sided). The batch
-//!   takes the BSDF type and sidedness of its first such hit; hits of another type or
-//!   sidedness, on all-delta BSDFs (conductor, dielectric, mirror: their estimator draws no
-//!   light sample), or on nothing, are finished lane by lane with `li_hit`.
+//!   takes the BSDF type and sidedness of its first such hit. The per-lane fallback, lane by
+//!   lane with `li_hit`: hits of another type or sidedness than the batch's, on all-delta
+//!   BSDFs (conductor, dielectric, mirror: their estimator draws no light sample), on a rough
+//!   conductor of coloured index (`Bsdf::lane_covered`), or on nothing.
 
 // Lane loops index a dozen structure-of-arrays fields by the same lane number; iterators
 // over one of them would hide that symmetry.
@@ -36,6 +44,7 @@ mod tables;
 mod tests;
 
 use super::direct::Direct;
+use super::strategies::First;
 use super::Strategy;
 use crate::bsdf::{Bsdf, BsdfKind, BsdfVisitor, Diffuse, Registered};
 use crate::geometry::ray_packet::bits;
@@ -43,8 +52,8 @@ use crate::geometry::{Accel, PacketHits, RayPacket};
 use crate::math::{Rgb, V3x8};
 use crate::rng::LANES;
 use crate::sampler::SamplerLanes;
-use crate::scene::Scene;
 use light::{LightDraws, SphereDraws};
+use shade::{Lanes, Pre};
 use tables::{LaneShape, LaneTables};
 
 // A pixel's eight samples trace their camera and shadow rays as one packet.
@@ -77,8 +86,8 @@ pub(super) struct CameraHits {
     pub(super) covered: u32,
 }
 
-/// The lanes' rays and candidate contributions, before visibility. Every shading pass writes
-/// every field of every lane.
+/// The lanes' rays and candidate contributions, before visibility. Each technique writes
+/// the fields of its lanes (area sampling's and the BSDF's: every lane).
 #[derive(Default)]
 #[repr(C)]
 pub(super) struct Shaded {
@@ -98,7 +107,10 @@ pub(super) struct Shaded {
 /// The working arrays of `li_lanes`, made once by the caller and reused by every batch: made
 /// per batch, they were copied out of the calls that fill them (a 872-byte memcpy) or zeroed
 /// (three memset calls per eight samples, 2.6 % of Cornell render time). Each batch writes
-/// what it reads; the fields some batches write only in part are cleared per batch.
+/// what it reads; the fields some batches write only in part are cleared per batch. They
+/// are separate references in the shading functions' arguments, not fields of one
+/// structure: a reference argument tells the compiler that nothing else writes its target;
+/// a reference in a field does not.
 #[derive(Default)]
 pub struct LaneScratch {
     hits: CameraHits,
@@ -106,21 +118,87 @@ pub struct LaneScratch {
     shaded: Shaded,
 }
 
+/// Which paths the lanes took, counted for the tests (whose coverage lists need to know that
+/// a configuration went where they meant it to).
+#[cfg(test)]
+#[derive(Default)]
+pub(crate) struct Paths(pub(crate) [std::sync::atomic::AtomicU64; Paths::N]);
+
+#[cfg(test)]
+impl Paths {
+    const N: usize = 7;
+    /// Batches of one material, of several, lanes finished by `li_hit`, light steps from the
+    /// tables, light steps lane by lane, draws for some lanes only, technique splits.
+    pub(crate) const NAMES: [&str; Paths::N] = [
+        "uniform batch",
+        "mixed batch",
+        "scalar lane",
+        "table lights",
+        "per-lane lights",
+        "masked draw",
+        "split",
+    ];
+    pub(crate) fn note(&self, what: usize, n: u64) {
+        self.0[what].fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+    }
+    /// The counts by name.
+    pub(crate) fn counts(&self) -> Vec<(&'static str, u64)> {
+        let get = |a: &std::sync::atomic::AtomicU64| a.load(std::sync::atomic::Ordering::Relaxed);
+        Self::NAMES
+            .iter()
+            .zip(&self.0)
+            .map(|(n, a)| (*n, get(a)))
+            .collect()
+    }
+}
+
 /// The direct estimator with its lane kernel: `li_lanes` shades eight camera samples at once
 /// where the module comment's rule covers them, and leaves the rest to `Direct::li`.
 pub struct LaneKernel<'a> {
+    #[cfg(test)]
+    pub(crate) paths: Paths,
     /// The scalar estimator, for the samples the lanes do not cover.
     pub direct: Direct<'a>,
-    /// The tables the lanes read, if they cover the scene and strategy.
+    /// The tables the lanes read (None: every sample takes the scalar path).
     tables: Option<LaneTables<'a>>,
+    /// The estimator's first call, whose numbers `li_lanes` draws before tracing.
+    first: First,
 }
 
 impl<'a> LaneKernel<'a> {
-    /// The estimator of `strategy` on `scene`, with the lane tables where they cover it.
-    pub fn new(scene: &'a Scene, strategy: Strategy) -> Self {
+    /// The estimator of `strategy` on `scene`, with its lane tables.
+    pub fn new(scene: &'a crate::scene::Scene, strategy: Strategy) -> Self {
         let direct = Direct::new(scene, strategy);
-        let tables = tables::lane_setup(scene, &direct.strategy, &direct.selector);
-        LaneKernel { direct, tables }
+        let tables = Some(tables::lane_setup(
+            scene,
+            &direct.strategy,
+            &direct.selector,
+        ));
+        // RIS draws its candidates lane by lane from each lane's sampler.
+        let first = match direct.ris {
+            Some(_) => First::Other,
+            None => First::of(strategy),
+        };
+        LaneKernel {
+            #[cfg(test)]
+            paths: Paths::default(),
+            direct,
+            tables,
+            first,
+        }
+    }
+
+    /// The same estimator shading every sample with `Direct::li`, one at a time: the
+    /// per-sample definition the lanes are tested against, and the baseline the bench
+    /// compares them with.
+    pub fn scalar(scene: &'a crate::scene::Scene, strategy: Strategy) -> Self {
+        LaneKernel {
+            #[cfg(test)]
+            paths: Paths::default(),
+            direct: Direct::new(scene, strategy),
+            tables: None,
+            first: First::Other,
+        }
     }
 
     /// `li` of the first `n` rays, each with its lane of `rng` (which must stand where `li`
@@ -150,51 +228,45 @@ impl<'a> LaneKernel<'a> {
             shaded,
         } = scratch;
         let mut out = [Rgb::ZERO; LANES];
-        // The seven numbers `li` draws after the camera's: light (emitter, triangle, point),
-        // then BSDF (lobe, direction). Drawn before the camera rays are traced, from a copy
-        // that lanes left to `li_hit` do not see: placed after, their chain of dependent
-        // 64-bit multiplications (about 15 cycles each) started only once traversal ended.
+        // The numbers of the estimator's first call, drawn from a copy that lanes left to
+        // `li_hit` do not see.
         let at_hit = rng.clone();
-        let [u0, u1, u2, u3] = rng.light();
-        let [u4, u5, u6] = rng.bsdf();
-        let mut u = [u0, u1, u2, u3, u4, u5, u6];
+        let pre = Pre::draw(self.first, rng);
         let scene = direct.scene;
         scene.intersect8_into(rays, (1 << n) - 1, &mut hits.camera);
         self.camera_hits(&tables.shapes, rays, &at_hit, &mut out, hits);
         if hits.covered == 0 {
             return out;
         }
-        if direct.ris.is_some() {
-            ris_numbers(direct, &at_hit, hits, &mut u, &mut draws.p_div);
+        let kind = &scene.materials[hits.first as usize].kind;
+        macro_rules! lanes {
+            ($spheres:literal) => {
+                Lanes::<(), L, $spheres> {
+                    kernel: self,
+                    tables,
+                    b: (),
+                    h: hits,
+                    rng,
+                    at_hit: &at_hit,
+                    pre,
+                    draws,
+                    o: shaded,
+                }
+            };
         }
-        let mut spheres = SphereDraws::default();
-        let small = tables.small_lights.as_deref();
-        let selector = &direct.selector;
-        LightDraws::draw(
-            selector,
-            &tables.lights,
-            small,
-            &u[0],
-            &u[1],
-            &hits.camera,
-            draws,
-            &mut spheres,
-        );
-        let (h, ld, sd) = (&*hits, &*draws, &spheres);
         // The study's diffuse batches lit by meshes inline here; every other BSDF type, and
-        // batches with a sphere light (a branch per lane), shade out of line, so that this
+        // scenes with a sphere light (a branch per lane), shade out of line, so that this
         // instance compiles as it would alone.
-        match &scene.materials[hits.first as usize].kind {
-            BsdfKind::Diffuse(_) if !spheres.any => {
-                self.shade_batch::<Diffuse, false>(h, ld, sd, &u, shaded, &mut out)
+        match (kind, tables.spheres) {
+            (BsdfKind::Diffuse(_), false) => {
+                self.shade_batch::<Diffuse, L, false>(lanes!(false), &mut out)
             }
-            kind => kind.visit(Batch {
-                kernel: self,
-                h,
-                ld,
-                sd,
-                u: &u,
-                shaded,
+            (kind, false) => kind.visit(Batch {
+                x: lanes!(false),
+                out: &mut out,
+            }),
+            (kind, true) => kind.visit(Batch {
+                x: lanes!(true),
                 out: &mut out,
             }),
         }
@@ -239,6 +311,8 @@ impl<'a> LaneKernel<'a> {
                 .material
                 .is_some_and(|m| m.key == batch.get_or_insert(m).key);
             if !covered {
+                #[cfg(test)]
+                self.paths.note(2, 1);
                 out[i] = direct.li_hit(&rays.ray(i), &camera.point(i), &mut rng.lane(i));
                 continue;
             }
@@ -293,17 +367,12 @@ impl<'a> LaneKernel<'a> {
 }
 
 /// A batch handed to the code of its BSDF type (`BsdfKind::visit`).
-struct Batch<'k, 'a> {
-    kernel: &'k LaneKernel<'a>,
-    h: &'k CameraHits,
-    ld: &'k LightDraws,
-    sd: &'k SphereDraws,
-    u: &'k [[f32; LANES]; 7],
-    shaded: &'k mut Shaded,
-    out: &'k mut [Rgb; LANES],
+struct Batch<'k, 'a, 'o, L: SamplerLanes, const SPHERES: bool> {
+    x: Lanes<'k, 'a, (), L, SPHERES>,
+    out: &'o mut [Rgb; LANES],
 }
 
-impl BsdfVisitor for Batch<'_, '_> {
+impl<L: SamplerLanes, const SPHERES: bool> BsdfVisitor for Batch<'_, '_, '_, L, SPHERES> {
     type Out = ();
 
     #[inline(always)]
@@ -312,49 +381,8 @@ impl BsdfVisitor for Batch<'_, '_> {
         if B::DELTA {
             return;
         }
-        let Batch {
-            kernel,
-            h,
-            ld,
-            sd,
-            u,
-            shaded,
-            out,
-        } = self;
-        match sd.any {
-            true => kernel.shade_batch_out_of_line::<B, true>(h, ld, sd, u, shaded, out),
-            false => kernel.shade_batch_out_of_line::<B, false>(h, ld, sd, u, shaded, out),
-        }
-    }
-}
-
-/// RIS over several candidates, whose draw `li` makes with 4M + 1 numbers: each covered
-/// lane's draw is `Direct::ris_for_lane` from the lane's own sampler. The kept candidate's
-/// numbers replace the lane's light numbers (the lane draw takes it again, bitwise as the
-/// scalar candidate), the numbers that follow are its BSDF numbers, and `p_div` is the
-/// density the lane's light estimate divides by. A lane that kept no candidate divides by
-/// infinity: its light sample, drawn from its unused numbers, adds zero, as in `li`.
-#[inline(never)]
-fn ris_numbers<L: SamplerLanes>(
-    direct: &Direct,
-    at_hit: &L,
-    h: &CameraHits,
-    u: &mut [[f32; LANES]; 7],
-    p_div: &mut [f32; LANES],
-) {
-    use crate::sampler::Sampler;
-    for i in bits(h.covered) {
-        let mut one = at_hit.lane(i);
-        match direct.ris_for_lane(&h.camera.point(i), h.d.get(i), &mut one) {
-            Some((dims, p)) => {
-                [u[0][i], u[1][i], u[2][i], u[3][i]] =
-                    [dims.select, dims.primitive, dims.point.x, dims.point.y];
-                p_div[i] = p;
-            }
-            None => p_div[i] = f32::INFINITY,
-        }
-        let b = one.bsdf();
-        [u[4][i], u[5][i], u[6][i]] = [b.lobe, b.direction.x, b.direction.y];
+        let kernel = self.x.kernel;
+        kernel.shade_batch_out_of_line::<B, L, SPHERES>(self.x, self.out)
     }
 }
 

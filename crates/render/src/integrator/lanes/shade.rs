@@ -1,125 +1,394 @@
-//! The lane kernel's one shading function, generic over the BSDF type, and the traversals
-//! and sums that finish a batch.
+//! The techniques in lanes: `Lanes` runs an estimator's light and BSDF samples
+//! (`strategies::Techniques`) for the covered lanes of a batch at once, with one instance of
+//! its code per BSDF type. Each step is a loop over the eight lanes that calls the scalar
+//! code `Direct`'s technique calls, in the same order, then traces the step's rays as a
+//! packet (shadow rays) or through the lanes' reject (BSDF rays), and adds each lane's term
+//! as `Direct` adds it.
 
 // Lane loops index a dozen structure-of-arrays fields by the same lane number; iterators
 // over one of them would hide that symmetry.
 #![allow(clippy::needless_range_loop)]
 
 use super::light::light_sample;
-use super::tables::SAMPLE_COUNTS;
+use super::tables::LaneTables;
 use super::{mask_of, CameraHits, LaneKernel, LightDraws, Shaded, SphereDraws};
 use crate::bsdf::{Bsdf, BsdfSample, Material, Registered};
 use crate::geometry::ray_packet::bits;
-use crate::integrator::direct::heuristic;
+use crate::integrator::strategies::{self, First, Techniques};
+use crate::integrator::{Direct, Strategy};
 use crate::math::{Frame, Rgb, V3x8};
 use crate::rng::LANES;
+use crate::sampler::{LightDims, Sampler, SamplerLanes};
 use crate::scene::Scene;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-/// `SAMPLE_COUNTS` as the f32 factors `li` uses.
-const SAMPLE_COUNTS_F32: (f32, f32) = (SAMPLE_COUNTS.0 as f32, SAMPLE_COUNTS.1 as f32);
+/// The numbers of the estimator's first call (`First`), drawn before the camera rays are
+/// traced: drawn after, their chain of dependent 64-bit multiplications (about 15 cycles
+/// each) started only once traversal ended.
+#[derive(Default)]
+pub(super) struct Pre {
+    light: Option<[[f32; LANES]; 4]>,
+    bsdf: Option<[[f32; LANES]; 3]>,
+}
 
-impl LaneKernel<'_> {
-    /// `shade` for a batch whose covered lanes have BSDFs of type `B`, copied here: read
-    /// where the scene keeps them, their fields were reloaded in every lane, since the
-    /// compiler could not tell that the kernel's stores leave them alone, and the loops ran
-    /// lane by lane. For the same reason the
-    /// arrays are separate arguments, not fields of one structure: a reference argument
-    /// tells the compiler that nothing else writes its target; a reference in a field
-    /// does not.
+impl Pre {
+    /// The numbers `first` draws, from `rng`, which is left after them.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)] // see `shade_batch`
-    pub(super) fn shade_batch<B: Bsdf + Registered, const SPHERES: bool>(
-        &self,
-        h: &CameraHits,
-        ld: &LightDraws,
-        sd: &SphereDraws,
-        u: &[[f32; LANES]; 7],
-        o: &mut Shaded,
-        out: &mut [Rgb; LANES],
-    ) {
-        let materials = &self.direct.scene.materials;
-        let first = *B::view(&materials[h.first as usize].kind)
-            .expect("the batch's first material has the batch's type");
-        match h.uniform {
-            true => self.shade::<B, SPHERES>(|_| &first, h, ld, sd, u, o, out),
-            false => self.shade_mixed::<B, SPHERES>(h, ld, sd, u, o, out),
-        }
+    pub(super) fn draw<L: SamplerLanes>(first: First, rng: &mut L) -> Pre {
+        let light = matches!(first, First::Light | First::LightAndBsdf).then(|| rng.light());
+        let bsdf = matches!(first, First::Bsdf | First::LightAndBsdf).then(|| rng.bsdf());
+        Pre { light, bsdf }
     }
+}
 
-    /// `shade_batch`, out of line (see `li_lanes`).
-    #[inline(never)]
-    #[allow(clippy::too_many_arguments)] // see `shade_batch`
-    pub(super) fn shade_batch_out_of_line<B: Bsdf + Registered, const SPHERES: bool>(
-        &self,
-        h: &CameraHits,
-        ld: &LightDraws,
-        sd: &SphereDraws,
-        u: &[[f32; LANES]; 7],
-        o: &mut Shaded,
-        out: &mut [Rgb; LANES],
-    ) {
-        self.shade_batch::<B, SPHERES>(h, ld, sd, u, o, out)
-    }
+/// What every technique of a batch reads of a lane's hit, computed once per batch: the
+/// incident direction in the BSDF's one-sided frame, whether it was mirrored there
+/// (`Material::side`), and the BSDF's `lane_shared` value.
+#[derive(Default)]
+struct Setup {
+    wi: V3x8,
+    shared: [f32; LANES],
+    flip: [bool; LANES],
+}
 
-    /// `shade_batch` for a batch of several materials (at a pixel straddling two), out of
-    /// line, so that the instance for one material, which nearly every batch takes,
-    /// compiles as it would alone.
-    #[inline(never)]
-    #[allow(clippy::too_many_arguments)] // see `shade_batch`
-    fn shade_mixed<B: Bsdf + Registered, const SPHERES: bool>(
-        &self,
-        h: &CameraHits,
-        ld: &LightDraws,
-        sd: &SphereDraws,
-        u: &[[f32; LANES]; 7],
-        o: &mut Shaded,
-        out: &mut [Rgb; LANES],
-    ) {
-        let materials = &self.direct.scene.materials;
-        let first = *B::view(&materials[h.first as usize].kind).expect("the batch's type");
-        // Each lane's BSDF; the first material's for lanes not covered.
-        let mut b = [first; LANES];
+/// A lane's light sample before its BSDF value: drawn or not, direction, the densities its
+/// weight and its estimate use, radiance, and its shadow ray's ends.
+struct LaneLight {
+    drawn: bool,
+    wi: Vec3,
+    p_light: f32,
+    p_div: f32,
+    li: Rgb,
+    delta: bool,
+    origin: Vec3,
+    target: Vec3,
+}
+
+/// The techniques for the covered lanes of a batch whose BSDFs have type `B` (lane i's is
+/// `b(i)`), with the sampler lanes `rng` standing after the camera's numbers (or after
+/// `pre`'s) and `at_hit` a copy of them from before `pre`.
+pub(super) struct Lanes<'k, 'a, F, L: SamplerLanes, const SPHERES: bool> {
+    pub(super) kernel: &'k LaneKernel<'a>,
+    pub(super) tables: &'k LaneTables<'a>,
+    pub(super) b: F,
+    pub(super) h: &'k CameraHits,
+    pub(super) rng: &'k mut L,
+    pub(super) at_hit: &'k L,
+    pub(super) pre: Pre,
+    pub(super) draws: &'k mut LightDraws,
+    pub(super) o: &'k mut Shaded,
+}
+
+impl<'k, 'a, B, F, L, const SPHERES: bool> Lanes<'k, 'a, F, L, SPHERES>
+where
+    B: Bsdf + 'k,
+    F: Fn(usize) -> &'k B + Copy,
+    L: SamplerLanes,
+{
+    /// Runs the strategy's estimator for the covered lanes and writes their estimates to
+    /// `out`.
+    #[inline(always)]
+    pub(super) fn run(self, out: &mut [Rgb; LANES]) {
+        let h = self.h;
+        let mut t = Techniques8 {
+            setup: setup(self.b, h),
+            l: h.le,
+            lanes: self,
+        };
+        strategies::li(&mut t, false);
         for i in bits(h.covered) {
-            b[i] = *B::view(&materials[h.material[i] as usize].kind).unwrap_or(&first);
+            out[i] = t.l.get(i);
         }
-        self.shade::<B, SPHERES>(|i| &b[i], h, ld, sd, u, o, out)
+    }
+}
+
+/// `Lanes` with its per-batch setup and its estimates so far.
+struct Techniques8<'k, 'a, F, L: SamplerLanes, const SPHERES: bool> {
+    lanes: Lanes<'k, 'a, F, L, SPHERES>,
+    setup: Setup,
+    l: V3x8,
+}
+
+impl<'k, B, F, L, const SPHERES: bool> Techniques8<'k, '_, F, L, SPHERES>
+where
+    B: Bsdf + 'k,
+    F: Fn(usize) -> &'k B + Copy,
+    L: SamplerLanes,
+{
+    /// `pre`'s numbers if the call that wants them is the first and runs for every lane
+    /// (`light`, `bsdf`: which numbers it draws); otherwise None, with `rng` put back to
+    /// where the hit left it if `pre` drew numbers that this call does not take.
+    #[inline(always)]
+    fn take_pre(&mut self, light: bool, bsdf: bool, full: bool) -> Option<Pre> {
+        let x = &mut self.lanes;
+        let has = (x.pre.light.is_some(), x.pre.bsdf.is_some());
+        if has == (false, false) {
+            return None;
+        }
+        let pre = std::mem::take(&mut x.pre);
+        if full && has == (light, bsdf) {
+            return Some(pre);
+        }
+        x.rng.clone_from(x.at_hit);
+        None
     }
 
-    /// The arithmetic of `Direct`'s `light_draw`, `light_finish` and `bsdf_draw` and the rays
-    /// of the two samples, for all lanes at once (lanes without a covered hit compute garbage,
-    /// dropped), then `trace_and_sum`.
+    /// The light numbers of the lanes in `live` (RIS: those of each lane's kept candidate,
+    /// with the density it divides by in `draws.p_div`); other covered lanes' samplers stay.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)] // see `shade_batch`
-    fn shade<'b, B: Bsdf + 'b, const SPHERES: bool>(
-        &self,
-        b: impl Fn(usize) -> &'b B + Copy,
-        h: &CameraHits,
-        ld: &LightDraws,
-        sd: &SphereDraws,
-        u: &[[f32; LANES]; 7],
-        o: &mut Shaded,
-        out: &mut [Rgb; LANES],
+    fn light_numbers(&mut self, live: u32) -> [[f32; LANES]; 4] {
+        let x = &mut self.lanes;
+        let h = x.h;
+        #[cfg(test)]
+        x.kernel.paths.note(5, (h.covered & !live != 0) as u64);
+        let direct = &x.kernel.direct;
+        if direct.ris.is_some() {
+            let mut u = [[0.0; LANES]; 4];
+            ris_numbers(direct, x.rng, h, live, &mut u, &mut x.draws.p_div);
+            return u;
+        }
+        masked(x.rng, live, h.covered, |r| r.light())
+    }
+
+    /// The BSDF numbers of the lanes in `live`.
+    #[inline(always)]
+    fn bsdf_numbers(&mut self, live: u32) -> [[f32; LANES]; 3] {
+        let x = &mut self.lanes;
+        #[cfg(test)]
+        x.kernel.paths.note(5, (x.h.covered & !live != 0) as u64);
+        masked(x.rng, live, x.h.covered, |r| r.bsdf())
+    }
+}
+
+/// Adds `x / n` to the estimate `l` of each lane of `m`, `x` zero outside `lit`. x / 1 is x
+/// exactly: a division by one is left out.
+#[inline(always)]
+fn add(l: &mut V3x8, x: &V3x8, lit: u32, m: u32, n: f32) {
+    let mut t = V3x8::default();
+    for i in 0..LANES {
+        t.set(
+            i,
+            if lit >> i & 1 != 0 {
+                x.get(i)
+            } else {
+                Rgb::ZERO
+            },
+        );
+    }
+    if n != 1.0 {
+        for i in 0..LANES {
+            t.set(i, t.get(i) / n);
+        }
+    }
+    for i in 0..LANES {
+        let (keep, sum) = (l.get(i), l.get(i) + t.get(i));
+        l.set(i, if m >> i & 1 != 0 { sum } else { keep });
+    }
+}
+
+impl<'k, B, F, L, const SPHERES: bool> Techniques for Techniques8<'k, '_, F, L, SPHERES>
+where
+    B: Bsdf + 'k,
+    F: Fn(usize) -> &'k B + Copy,
+    L: SamplerLanes,
+{
+    type Mask = u32;
+
+    #[inline(always)]
+    fn strategy(&self) -> &Strategy {
+        &self.lanes.kernel.direct.strategy
+    }
+
+    #[inline(always)]
+    fn has_delta_lights(&self) -> bool {
+        self.lanes.kernel.direct.has_delta_lights()
+    }
+
+    #[inline(always)]
+    fn has_delta_lobe(&self) -> bool {
+        B::DELTA_LOBE
+    }
+
+    #[inline(always)]
+    fn all(&self) -> u32 {
+        self.lanes.h.covered
+    }
+
+    #[inline(always)]
+    fn light(&mut self, m: u32, weight: impl Fn(f32, f32) -> f32 + Copy, n: f32) {
+        let live = m & self.lanes.h.covered;
+        if live == 0 {
+            return;
+        }
+        let u = match self.take_pre(true, false, live == self.lanes.h.covered) {
+            Some(pre) => pre.light.expect("the first call's light numbers"),
+            None => self.light_numbers(live),
+        };
+        let x = &mut self.lanes;
+        let (h, s) = (x.h, &self.setup);
+        shade_light::<B, SPHERES>(
+            x.kernel, x.tables, x.b, h, s, &u, x.draws, x.o, live, weight,
+        );
+        let lit = trace_light(x.kernel.direct.scene, h, x.o, live);
+        add(&mut self.l, &x.o.light, lit, live, n);
+    }
+
+    #[inline(always)]
+    fn bsdf(&mut self, m: u32, weight: impl Fn(f32, f32) -> f32 + Copy, n: f32) {
+        let live = m & self.lanes.h.covered;
+        if live == 0 {
+            return;
+        }
+        let u = match self.take_pre(false, true, live == self.lanes.h.covered) {
+            Some(pre) => pre.bsdf.expect("the first call's BSDF numbers"),
+            None => self.bsdf_numbers(live),
+        };
+        let x = &mut self.lanes;
+        shade_bsdf(x.b, x.h, &self.setup, &u, x.o, live);
+        let bsdf = trace_bsdf::<SPHERES>(&x.kernel.direct, x.h, x.o, live, weight);
+        add(&mut self.l, &bsdf, !0, live, n);
+    }
+
+    #[inline(always)]
+    fn light_and_bsdf(
+        &mut self,
+        light_weight: impl Fn(f32, f32) -> f32 + Copy,
+        ne: f32,
+        bsdf_weight: impl Fn(f32, f32) -> f32 + Copy,
+        nb: f32,
     ) {
-        let s = &self.direct.strategy;
-        let (ne, nb) = SAMPLE_COUNTS_F32;
-        let mut wi_up = V3x8::default();
-        let mut shared = [0.0f32; LANES];
-        let mut flip = [false; LANES];
-        let ris = self.direct.ris.is_some();
+        let live = self.lanes.h.covered;
+        let (ul, ub) = match self.take_pre(true, true, true) {
+            Some(pre) => (
+                pre.light.expect("the first call's light numbers"),
+                pre.bsdf.expect("the first call's BSDF numbers"),
+            ),
+            None => {
+                let ul = self.light_numbers(live);
+                (ul, self.bsdf_numbers(live))
+            }
+        };
+        let x = &mut self.lanes;
+        let (k, h, s) = (x.kernel, x.h, &self.setup);
+        shade_light::<B, SPHERES>(
+            k,
+            x.tables,
+            x.b,
+            h,
+            s,
+            &ul,
+            x.draws,
+            x.o,
+            live,
+            light_weight,
+        );
+        shade_bsdf(x.b, h, s, &ub, x.o, live);
+        let lit = trace_light(k.direct.scene, h, x.o, live);
+        let bsdf = trace_bsdf::<SPHERES>(&k.direct, h, x.o, live, bsdf_weight);
+        add(&mut self.l, &x.o.light, lit, live, ne);
+        add(&mut self.l, &bsdf, !0, live, nb);
+    }
+
+    #[inline(always)]
+    fn split(&mut self, c: f32) -> (u32, u32) {
+        #[cfg(test)]
+        self.lanes.kernel.paths.note(6, 1);
+        self.take_pre(false, false, false);
+        let x = &mut self.lanes;
+        let mut below = 0;
+        for i in bits(x.h.covered) {
+            let mut one = x.rng.lane(i);
+            below |= ((one.technique() < c) as u32) << i;
+            x.rng.set_lane(i, &one);
+        }
+        (below, x.h.covered & !below)
+    }
+}
+
+/// `draw(rng)` for the lanes in `live`: covered lanes outside it keep their samplers.
+#[inline(always)]
+fn masked<L: SamplerLanes, T>(
+    rng: &mut L,
+    live: u32,
+    covered: u32,
+    draw: impl FnOnce(&mut L) -> T,
+) -> T {
+    let keep = covered & !live;
+    if keep == 0 {
+        return draw(rng);
+    }
+    let before = rng.clone();
+    let u = draw(rng);
+    for i in bits(keep) {
+        rng.set_lane(i, &before.lane(i));
+    }
+    u
+}
+
+/// Each lane's `Setup`.
+#[inline(always)]
+fn setup<'b, B: Bsdf + 'b>(b: impl Fn(usize) -> &'b B + Copy, h: &CameraHits) -> Setup {
+    let mut s = Setup::default();
+    for i in 0..LANES {
+        let frame = Frame::from_normal(h.camera.point(i).ns);
+        // `Material::eval_pdf`'s orientation, once for every sample of the hit.
+        let (wi, flipped) = Material::side(h.two_sided, frame.to_local(-h.d.get(i)));
+        s.wi.set(i, wi);
+        (s.shared[i], s.flip[i]) = (b(i).lane_shared(wi), flipped);
+    }
+    s
+}
+
+/// The arithmetic of `Direct::light_draw` and `light_finish` before its visibility test, for
+/// the lanes of `live` with numbers `u`: each lane's term, whether it may be nonzero, and
+/// its shadow ray, in `o`. Area sampling of area lights reads the lane tables for all lanes
+/// at once (lanes outside `live` compute garbage, dropped); anything else draws each live
+/// lane's light with `Direct::candidate`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)] // the lanes' arrays, each its own argument (see `LaneScratch`)
+fn shade_light<'b, B: Bsdf + 'b, const SPHERES: bool>(
+    k: &LaneKernel,
+    tables: &LaneTables,
+    b: impl Fn(usize) -> &'b B + Copy,
+    h: &CameraHits,
+    s: &Setup,
+    u: &[[f32; LANES]; 4],
+    ld: &mut LightDraws,
+    o: &mut Shaded,
+    live: u32,
+    weight: impl Fn(f32, f32) -> f32 + Copy,
+) {
+    let direct = &k.direct;
+    let ris = direct.ris.is_some();
+    #[cfg(test)]
+    k.paths.note(if tables.area { 3 } else { 4 }, 1);
+    if tables.area {
+        let mut spheres = SphereDraws::default();
+        let small = tables.small_lights.as_deref();
+        let selector = &direct.selector;
+        LightDraws::draw(
+            selector,
+            &tables.lights,
+            small,
+            &u[0],
+            &u[1],
+            &h.camera,
+            ld,
+            &mut spheres,
+        );
+        let (ld, sd) = (&*ld, &spheres);
+        // `light_lane` spelled out for area lights (never delta): passed through its
+        // record, this loop stopped compiling to vector code.
         for i in 0..LANES {
             let sp = h.camera.point(i);
             let (p, frame) = (sp.p, Frame::from_normal(sp.ns));
-            // `Material::eval_pdf`'s orientation, once for both samples.
-            let (wi, flipped) = Material::side(h.two_sided, frame.to_local(-h.d.get(i)));
-            let lane_shared = b(i).lane_shared(wi);
             let (drawn, wl, pdf_area, radiance, lsp) = light_sample::<SPHERES>(p, ld, sd, u, i);
-            // `light_finish` before its visibility test.
-            let wo = Material::mirror(flipped, frame.to_local(wl));
-            let (f, pdf_bsdf) = b(i).eval_pdf_shared(wi, wo, lane_shared);
+            let wo = Material::mirror(s.flip[i], frame.to_local(wl));
+            let (f, pdf_bsdf) = b(i).eval_pdf_shared(s.wi.get(i), wo, s.shared[i]);
             let p_light = ld.pmf[i] * pdf_area;
-            let w = heuristic(s.heuristic, ne * p_light, nb * pdf_bsdf);
-            // RIS divides by its own density; the MIS weight takes pmf * pdf (see `LightDraw`).
+            let w = weight(p_light, pdf_bsdf);
+            // RIS divides by its own density; the MIS weight takes pmf * pdf (see
+            // `LightDraw`).
             let p_div = if ris { ld.p_div[i] } else { p_light };
             o.light.set(i, f * radiance * (w / p_div));
             o.light_ok[i] = drawn && f != Rgb::ZERO && radiance != Rgb::ZERO;
@@ -128,72 +397,226 @@ impl LaneKernel<'_> {
             let target = lsp.spawn_origin(so - lp);
             o.shadow
                 .set(i, &Scene::shadow_ray_to(so, target, h.skip[i]));
-            wi_up.set(i, wi);
-            (shared[i], flip[i]) = (lane_shared, flipped);
         }
-        // `bsdf_draw`: `Material::sample` with the orientation above.
-        let bs = B::sample_lanes(b, &wi_up, &shared, &[u[4], u[5], u[6]], h.covered);
-        for i in 0..LANES {
-            let sp = h.camera.point(i);
-            (o.bsdf_ok[i], o.bsdf_pdf[i], o.bsdf_delta[i]) = (bs.ok[i], bs.pdf[i], bs.delta[i]);
-            o.bsdf_weight.set(i, bs.weight.get(i));
-            // `bsdf_finish`'s ray (`Scene::bsdf_ray`).
-            let d = Frame::from_normal(sp.ns).to_world(Material::mirror(flip[i], bs.wo.get(i)));
-            o.bsdf
-                .set(i, &Scene::ray_from(sp.spawn_origin(d), d, h.skip[i]));
-        }
-        self.trace_and_sum::<SPHERES>(h, o, out);
+        return;
     }
+    for i in bits(live) {
+        let sp = h.camera.point(i);
+        let dims = LightDims {
+            select: u[0][i],
+            primitive: u[1][i],
+            point: Vec2::new(u[2][i], u[3][i]),
+        };
+        let Some((ls, pmf)) = direct.candidate(&sp, dims) else {
+            o.light_ok[i] = false;
+            continue;
+        };
+        let (origin, target) = Scene::shadow_ends(&sp, &ls);
+        let p_light = pmf * ls.pdf;
+        let light = LaneLight {
+            drawn: true,
+            wi: ls.wi,
+            p_light,
+            p_div: if ris { ld.p_div[i] } else { p_light },
+            li: ls.li,
+            delta: ls.delta,
+            origin,
+            target,
+        };
+        light_lane(b(i), s, i, &sp, h.skip[i], &light, weight, o);
+    }
+}
 
-    /// The traversals (the shadow rays as one packet, then the BSDF rays one at a time) and
-    /// the estimate of each covered lane, summed in `li`'s order.
+/// `light_finish` before its visibility test, for lane i.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn light_lane<B: Bsdf>(
+    b: &B,
+    s: &Setup,
+    i: usize,
+    sp: &crate::geometry::SurfacePoint,
+    skip: u32,
+    l: &LaneLight,
+    weight: impl Fn(f32, f32) -> f32 + Copy,
+    o: &mut Shaded,
+) {
+    let frame = Frame::from_normal(sp.ns);
+    let wo = Material::mirror(s.flip[i], frame.to_local(l.wi));
+    let (f, pdf) = b.eval_pdf_shared(s.wi.get(i), wo, s.shared[i]);
+    let p_bsdf = if l.delta { 0.0 } else { pdf };
+    let w = weight(l.p_light, p_bsdf);
+    o.light.set(i, f * l.li * (w / l.p_div));
+    o.light_ok[i] = l.drawn && f != Rgb::ZERO && l.li != Rgb::ZERO;
+    o.shadow
+        .set(i, &Scene::shadow_ray_to(l.origin, l.target, skip));
+}
+
+/// The shadow rays of the lanes of `live` with a possible term, as one packet: the mask of
+/// those that reach their light.
+#[inline(always)]
+fn trace_light(scene: &Scene, h: &CameraHits, o: &Shaded, live: u32) -> u32 {
+    let traced = live & h.covered & mask_of(&o.light_ok);
+    traced & !scene.accel.occluded8(&o.shadow, traced)
+}
+
+/// `bsdf_draw` (`Material::sample` with `Setup`'s orientation) and `bsdf_finish`'s ray, for
+/// the lanes of `live` with numbers `u`, in `o`.
+#[inline(always)]
+fn shade_bsdf<'b, B: Bsdf + 'b>(
+    b: impl Fn(usize) -> &'b B + Copy,
+    h: &CameraHits,
+    s: &Setup,
+    u: &[[f32; LANES]; 3],
+    o: &mut Shaded,
+    live: u32,
+) {
+    let bs = B::sample_lanes(b, &s.wi, &s.shared, u, live);
+    for i in 0..LANES {
+        let sp = h.camera.point(i);
+        (o.bsdf_ok[i], o.bsdf_pdf[i], o.bsdf_delta[i]) = (bs.ok[i], bs.pdf[i], bs.delta[i]);
+        o.bsdf_weight.set(i, bs.weight.get(i));
+        // `bsdf_finish`'s ray (`Scene::bsdf_ray`).
+        let d = Frame::from_normal(sp.ns).to_world(Material::mirror(s.flip[i], bs.wo.get(i)));
+        o.bsdf
+            .set(i, &Scene::ray_from(sp.spawn_origin(d), d, h.skip[i]));
+    }
+}
+
+/// The BSDF rays of the lanes of `live`, put through `bsdf_ray_hit`'s reject in lanes
+/// (without sphere lights, its box reject alone); those it lets through are traced one by
+/// one. Each lane's weighted emission (zero where none is reached).
+#[inline(always)]
+fn trace_bsdf<const SPHERES: bool>(
+    direct: &Direct,
+    h: &CameraHits,
+    o: &Shaded,
+    live: u32,
+    weight: impl Fn(f32, f32) -> f32 + Copy,
+) -> V3x8 {
+    let scene = direct.scene;
+    let rays = &o.bsdf;
+    let open = live & h.covered & mask_of(&o.bsdf_ok);
+    let mut out = V3x8::default();
+    for i in bits(scene.bsdf_rays_may_hit::<SPHERES>(rays, open)) {
+        let ray = rays.ray(i);
+        if let Some(hit) = scene.bsdf_ray_hit_traced(&ray, h.emitter_skip[i]) {
+            let bs = BsdfSample {
+                wo: Vec3::ZERO,
+                weight: o.bsdf_weight.get(i),
+                pdf: o.bsdf_pdf[i],
+                delta: o.bsdf_delta[i],
+            };
+            let from = h.camera.point(i);
+            out.set(i, direct.bsdf_emission(&from, ray.d, &hit, &bs, weight));
+        }
+    }
+    out
+}
+
+/// RIS over several candidates, whose draw `li` makes with 4M + 1 numbers: each lane of
+/// `live` draws with `Direct::ris_for_lane` from its own sampler, which is left after the
+/// draw. The kept candidate's numbers are the lane's light numbers (the lane's light draw
+/// takes it again, bitwise as the scalar candidate) and `p_div` the density the lane's
+/// estimate divides by. A lane that kept no candidate divides by infinity: its light
+/// sample, drawn from numbers 0, adds zero, as in `li`.
+#[inline(never)]
+fn ris_numbers<L: SamplerLanes>(
+    direct: &Direct,
+    rng: &mut L,
+    h: &CameraHits,
+    live: u32,
+    u: &mut [[f32; LANES]; 4],
+    p_div: &mut [f32; LANES],
+) {
+    for i in bits(live) {
+        let mut one = rng.lane(i);
+        match direct.ris_for_lane(&h.camera.point(i), h.d.get(i), &mut one) {
+            Some((dims, p)) => {
+                [u[0][i], u[1][i], u[2][i], u[3][i]] =
+                    [dims.select, dims.primitive, dims.point.x, dims.point.y];
+                p_div[i] = p;
+            }
+            None => p_div[i] = f32::INFINITY,
+        }
+        rng.set_lane(i, &one);
+    }
+}
+
+/// A batch's estimator with its BSDF type resolved (`LaneKernel::li_lanes`).
+impl LaneKernel<'_> {
+    /// The estimates of the covered lanes of a batch whose first material has BSDF type
+    /// `B`: its BSDFs copied next to the working arrays, where the compiler can see that no
+    /// store of the kernel changes them (read where the scene keeps them, their fields were
+    /// reloaded in every lane).
     #[inline(always)]
-    fn trace_and_sum<const SPHERES: bool>(
-        &self,
-        h: &CameraHits,
-        sh: &Shaded,
+    pub(super) fn shade_batch<'k, B: Bsdf + Registered, L: SamplerLanes, const SPHERES: bool>(
+        &'k self,
+        x: Lanes<'k, '_, (), L, SPHERES>,
         out: &mut [Rgb; LANES],
     ) {
-        let direct = &self.direct;
-        let scene = direct.scene;
-        let s = &direct.strategy;
-        let (ne, nb) = SAMPLE_COUNTS_F32;
-        let bsdf_w = |pb, pl| heuristic(s.heuristic, nb * pb, ne * pl);
-        // Every lane's ray is computed; only those of covered lanes with a light sample
-        // are traced.
-        let traced = h.covered & mask_of(&sh.light_ok);
-        let blocked = scene.accel.occluded8(&sh.shadow, traced);
-        // The BSDF rays, put through `bsdf_ray_hit`'s reject in lanes (without sphere lights,
-        // its box reject alone): only those it lets through are traced, one by one.
-        let bsdf_rays = &sh.bsdf;
-        let open = h.covered & mask_of(&sh.bsdf_ok);
-        let mut bsdf = V3x8::default();
-        for i in bits(scene.bsdf_rays_may_hit::<SPHERES>(bsdf_rays, open)) {
-            let ray = bsdf_rays.ray(i);
-            if let Some(hit) = scene.bsdf_ray_hit_traced(&ray, h.emitter_skip[i]) {
-                let bs = BsdfSample {
-                    wo: Vec3::ZERO,
-                    weight: sh.bsdf_weight.get(i),
-                    pdf: sh.bsdf_pdf[i],
-                    delta: sh.bsdf_delta[i],
-                };
-                let from = h.camera.point(i);
-                bsdf.set(i, direct.bsdf_emission(&from, ray.d, &hit, &bs, bsdf_w));
-            }
+        let materials = &self.direct.scene.materials;
+        let first = *B::view(&materials[x.h.first as usize].kind)
+            .expect("the batch's first material has the batch's type");
+        #[cfg(test)]
+        self.paths.note(x.h.uniform as usize ^ 1, 1);
+        match x.h.uniform {
+            true => x.with(|_| &first).run(out),
+            false => self.shade_mixed::<B, L, SPHERES>(x, first, out),
         }
-        // `li`'s sum, in its order, for all lanes at once; only covered lanes are kept.
-        let lit = traced & !blocked;
-        let mut sum = V3x8::default();
-        for i in 0..LANES {
-            let light = if lit >> i & 1 != 0 {
-                sh.light.get(i)
-            } else {
-                Rgb::ZERO
-            };
-            sum.set(i, h.le.get(i) + light / ne + bsdf.get(i) / nb);
+    }
+
+    /// `shade_batch`, out of line (see `li_lanes`).
+    #[inline(never)]
+    pub(super) fn shade_batch_out_of_line<
+        'k,
+        B: Bsdf + Registered,
+        L: SamplerLanes,
+        const SPHERES: bool,
+    >(
+        &'k self,
+        x: Lanes<'k, '_, (), L, SPHERES>,
+        out: &mut [Rgb; LANES],
+    ) {
+        self.shade_batch::<B, L, SPHERES>(x, out)
+    }
+
+    /// `shade_batch` for a batch of several materials (at a pixel straddling two), out of
+    /// line, so that the instance for one material, which nearly every batch takes,
+    /// compiles as it would alone.
+    #[inline(never)]
+    fn shade_mixed<B: Bsdf + Registered, L: SamplerLanes, const SPHERES: bool>(
+        &self,
+        x: Lanes<'_, '_, (), L, SPHERES>,
+        first: B,
+        out: &mut [Rgb; LANES],
+    ) {
+        let materials = &self.direct.scene.materials;
+        // Each lane's BSDF; the first material's for lanes not covered.
+        let mut b = [first; LANES];
+        for i in bits(x.h.covered) {
+            b[i] = *B::view(&materials[x.h.material[i] as usize].kind).unwrap_or(&first);
         }
-        for i in bits(h.covered) {
-            out[i] = sum.get(i);
+        x.with(|i| &b[i]).run(out)
+    }
+}
+
+impl<'k, 'a, L: SamplerLanes, const SPHERES: bool> Lanes<'k, 'a, (), L, SPHERES> {
+    /// The batch with lane i's BSDF `b(i)`.
+    #[inline(always)]
+    fn with<'r, F>(self, b: F) -> Lanes<'r, 'a, F, L, SPHERES>
+    where
+        'k: 'r,
+    {
+        Lanes {
+            kernel: self.kernel,
+            tables: self.tables,
+            b,
+            h: self.h,
+            rng: self.rng,
+            at_hit: self.at_hit,
+            pre: self.pre,
+            draws: self.draws,
+            o: self.o,
         }
     }
 }

@@ -9,7 +9,6 @@ use crate::integrator::Strategy;
 use crate::rng::LANES;
 use crate::sampling::elementary::small_int_bits;
 use crate::sampling::AliasTable;
-use crate::scene::desc::StrategyKind;
 use crate::scene::Scene;
 use glam::Vec3;
 
@@ -176,6 +175,12 @@ pub(super) struct LaneShape {
 
 /// The tables of the lanes: one light per emitter, one record per shape.
 pub(super) struct LaneTables<'a> {
+    /// Whether the lanes draw light samples from `lights` (area sampling, every emitter an
+    /// area light on a mesh or a sphere); otherwise with `Direct::candidate`, lane by lane.
+    pub(super) area: bool,
+    /// Whether some emitter is a sphere (the lanes then test for sphere lights).
+    pub(super) spheres: bool,
+    /// One per emitter, where `area`.
     pub(super) lights: Vec<LaneLight<'a>>,
     pub(super) shapes: Vec<LaneShape>,
     /// The emitter choice in lane form, for two to eight emitters.
@@ -230,21 +235,25 @@ impl SmallLights {
     }
 }
 
-/// The light and BSDF sample counts of the only strategies the lanes cover
-/// (`lane_setup`). As constants, `Direct::li`'s divisions by them and multiplications compile
-/// to nothing, which dividing by a 1 read from the strategy did not. x / 1 and 1 * x are x
-/// exactly, so every sample is still bitwise `li`'s.
-pub(super) const SAMPLE_COUNTS: (u32, u32) = (1, 1);
-
-/// The lanes' tables if the scene and strategy are the configuration the lanes cover;
-/// otherwise None and `Direct` shades every sample with `li`.
+/// The lanes' tables for the scene and strategy.
 pub(super) fn lane_setup<'a>(
     scene: &'a Scene,
     s: &Strategy,
     selector: &EmitterSelector,
-) -> Option<LaneTables<'a>> {
-    let lights = lane_lights(scene, s)?;
+) -> LaneTables<'a> {
+    let lights = lane_lights(scene, s);
+    let area = lights.is_some();
+    let lights = lights.unwrap_or_default();
     let small_lights = SmallLights::new(&lights, selector).map(Box::new);
+    let spheres = scene.emitters.iter().any(|e| match e {
+        Emitter::Area(light) => {
+            matches!(
+                scene.shapes[light.shape as usize].kind,
+                ShapeKind::Sphere(_)
+            )
+        }
+        Emitter::Point(_) => false,
+    });
     let shapes = (0u32..)
         .zip(&scene.shapes)
         .map(|(shape, sh)| {
@@ -265,20 +274,19 @@ pub(super) fn lane_setup<'a>(
             }
         })
         .collect();
-    Some(LaneTables {
+    LaneTables {
+        area,
+        spheres,
         lights,
         shapes,
         small_lights,
-    })
+    }
 }
 
-/// The lane lights, one per emitter, if the scene and strategy are the configuration the
-/// lanes cover.
+/// The lane lights, one per emitter, if the lanes draw from tables: area sampling, every
+/// emitter an area light on a mesh or a sphere.
 fn lane_lights<'a>(scene: &'a Scene, s: &Strategy) -> Option<Vec<LaneLight<'a>>> {
-    let covered = s.kind == StrategyKind::Mis
-        && (s.emitter_samples, s.bsdf_samples) == SAMPLE_COUNTS
-        && s.light_sampling == LightSampling::Area
-        && !scene.emitters.is_empty();
+    let covered = s.light_sampling == LightSampling::Area && !scene.emitters.is_empty();
     if !covered {
         return None;
     }
@@ -321,7 +329,7 @@ mod tests {
     fn mis() -> Strategy {
         Strategy::combinations()
             .into_iter()
-            .find(|s| s.kind == StrategyKind::Mis && s.emitter_samples == 1)
+            .find(|s| s.kind == crate::scene::desc::StrategyKind::Mis && s.emitter_samples == 1)
             .unwrap()
     }
 
@@ -341,8 +349,8 @@ mod tests {
                 &scene,
                 &mis(),
                 &EmitterSelector::new(&scene.emitters, &scene.shapes, mis().selection),
-            )
-            .expect("covered");
+            );
+            assert!(lanes.area, "{rel}: tables");
             assert_eq!(lanes.shapes.len(), scene.shapes.len());
             // Rows by (lanes shade it, two-sided).
             let mut kinds = [[0; 2]; 2];
@@ -412,8 +420,8 @@ mod tests {
             &scene,
             &mis(),
             &EmitterSelector::new(&scene.emitters, &scene.shapes, mis().selection),
-        )
-        .expect("covered");
+        );
+        assert!(lanes.area);
         let mut checked = 0;
         for (light, e) in lanes.lights.iter().zip(&scene.emitters) {
             let LaneLightKind::Mesh {

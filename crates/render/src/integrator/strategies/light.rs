@@ -1,9 +1,7 @@
 //! Light sampling alone (Nori's `light`): `emitter_samples` light samples per camera sample.
 
-use super::{Direct, Estimator, Shading};
+use super::{Direct, Estimator, Techniques};
 use crate::integrator::Strategy;
-use crate::math::Rgb;
-use crate::sampler::Sampler;
 use crate::scene::desc::StrategyKind;
 
 /// Light sampling alone.
@@ -13,27 +11,26 @@ impl Estimator for Light {
     const KIND: StrategyKind = StrategyKind::Light;
 
     #[inline(always)]
-    fn li(d: &Direct, sh: &Shading, delta_bsdf: bool, rng: &mut impl Sampler, mut l: Rgb) -> Rgb {
-        let s = &d.strategy;
-        let ne = s.emitter_samples as f32;
+    fn li<T: Techniques>(t: &mut T, delta_bsdf: bool) {
+        let (n, all) = (t.strategy().emitter_samples, t.all());
+        let ne = n as f32;
         if delta_bsdf {
             // A delta BSDF gives light samples zero throughput: its light arrives by BSDF
             // samples, one in place of each light sample.
-            for _ in 0..s.emitter_samples {
-                l += d.bsdf_sample(sh, rng, Direct::only_other) / ne;
+            for _ in 0..n {
+                t.bsdf(all, Direct::only_other, ne);
             }
-            return l;
+            return;
         }
         // A delta lobe beside lobes with a density (plastic's coating): light samples for the
         // latter, and a BSDF sample each that counts only the delta lobe.
-        let delta_lobe = sh.mat.has_delta_lobe();
-        for _ in 0..s.emitter_samples {
-            l += d.light_sample(sh, rng, |_, _| 1.0) / ne;
+        let delta_lobe = t.has_delta_lobe();
+        for _ in 0..n {
+            t.light(all, |_, _| 1.0, ne);
             if delta_lobe {
-                l += d.bsdf_sample(sh, rng, Direct::only_other) / ne;
+                t.bsdf(all, Direct::only_other, ne);
             }
         }
-        l
     }
 
     fn label(s: &Strategy, _: &str, sel: &str, ls: &str) -> String {

@@ -2,11 +2,9 @@
 //! c = n_e / (n_e + n_b) (0 for a delta BSDF), else the BSDF technique, and weights by
 //! h(c_i p_i, c_j p_j) / c_i.
 
-use super::{Direct, Estimator, Shading};
+use super::{Estimator, Techniques};
 use crate::integrator::direct::heuristic;
 use crate::integrator::Strategy;
-use crate::math::Rgb;
-use crate::sampler::Sampler;
 use crate::scene::desc::StrategyKind;
 
 /// One-sample MIS.
@@ -16,21 +14,23 @@ impl Estimator for MisOneSample {
     const KIND: StrategyKind = StrategyKind::MisOneSample;
 
     #[inline(always)]
-    fn li(d: &Direct, sh: &Shading, delta_bsdf: bool, rng: &mut impl Sampler, mut l: Rgb) -> Rgb {
-        let s = &d.strategy;
+    fn li<T: Techniques>(t: &mut T, delta_bsdf: bool) {
+        let s = *t.strategy();
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
         let c_light = if delta_bsdf { 0.0 } else { ne / (ne + nb) };
         let c_bsdf = 1.0 - c_light;
-        if rng.technique() < c_light {
-            l += d.light_sample(sh, rng, |pl, pb| {
-                heuristic(s.heuristic, c_light * pl, c_bsdf * pb) / c_light
-            });
-        } else {
-            l += d.bsdf_sample(sh, rng, |pb, pl| {
-                heuristic(s.heuristic, c_bsdf * pb, c_light * pl) / c_bsdf
-            });
-        }
-        l
+        // Each hit takes one technique; its term is added undivided (x / 1 is x exactly).
+        let (light, bsdf) = t.split(c_light);
+        t.light(
+            light,
+            move |pl, pb| heuristic(s.heuristic, c_light * pl, c_bsdf * pb) / c_light,
+            1.0,
+        );
+        t.bsdf(
+            bsdf,
+            move |pb, pl| heuristic(s.heuristic, c_bsdf * pb, c_light * pl) / c_bsdf,
+            1.0,
+        );
     }
 
     fn label(_: &Strategy, h: &str, sel: &str, ls: &str) -> String {

@@ -12,23 +12,27 @@ mod bsdf;
 mod light;
 mod mis;
 mod mis_onesample;
+mod techniques;
 
-use super::direct::{Direct, Shading};
+use super::direct::Direct;
 use super::Strategy;
 use crate::geometry::{Ray, SurfacePoint};
 use crate::math::Rgb;
 use crate::named::Named;
 use crate::sampler::Sampler;
 use crate::scene::desc::StrategyKind;
+pub(super) use techniques::{First, One, Techniques};
 
-/// An estimator of the light a camera ray's hit receives directly.
+/// An estimator of the light a camera ray's hit receives directly, written once against
+/// [`Techniques`]: `Direct` runs it for one hit, the lane kernel for the hits of eight
+/// samples at once.
 pub(super) trait Estimator {
     /// The strategy it estimates for.
     const KIND: StrategyKind;
-    /// `l` (the emission the camera ray sees) plus the estimate at the shading point `sh`,
-    /// each sample's term added to `l` in turn. `delta_bsdf`: every lobe of the material is
-    /// a delta.
-    fn li(d: &Direct, sh: &Shading, delta_bsdf: bool, rng: &mut impl Sampler, l: Rgb) -> Rgb;
+    /// Adds the estimate at the hits `t` shades to what `t` holds (the emission the camera
+    /// ray sees), each sample's term in turn. `delta_bsdf`: every lobe of the material is a
+    /// delta (never so in lanes, which leave such hits to `Direct`).
+    fn li<T: Techniques>(t: &mut T, delta_bsdf: bool);
     /// The settings the strategy uses, after the kind's short form in its label: heuristic
     /// `h`, light samples `eN`, BSDF samples `bM`, emitter choice `sel`, light sampling `ls`.
     fn label(s: &Strategy, h: &str, sel: &str, ls: &str) -> String;
@@ -36,18 +40,12 @@ pub(super) trait Estimator {
 
 macro_rules! estimators {
     ($($ty:path),* $(,)?) => {
-        /// The estimate of `d`'s strategy at `sh`.
+        /// The estimate of `t`'s strategy at the hits it shades.
         #[inline(always)]
-        pub(super) fn li(
-            d: &Direct,
-            sh: &Shading,
-            delta_bsdf: bool,
-            rng: &mut impl Sampler,
-            l: Rgb,
-        ) -> Rgb {
-            let kind = d.strategy.kind;
+        pub(in crate::integrator) fn li<T: Techniques>(t: &mut T, delta_bsdf: bool) {
+            let kind = t.strategy().kind;
             $(if kind == <$ty as Estimator>::KIND {
-                return <$ty as Estimator>::li(d, sh, delta_bsdf, rng, l);
+                return <$ty as Estimator>::li(t, delta_bsdf);
             })*
             unreachable!("every strategy has an estimator (registry tests)")
         }
@@ -99,7 +97,9 @@ impl Direct<'_> {
         // A delta BSDF gives light samples zero throughput: all its light arrives via BSDF
         // samples, which then carry weight 1.
         let delta_bsdf = sh.mat.is_delta();
-        li(self, &sh, delta_bsdf, rng, l)
+        let mut one = One::new(self, &sh, rng, l);
+        li(&mut one, delta_bsdf);
+        one.l
     }
 }
 
