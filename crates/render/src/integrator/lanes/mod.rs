@@ -381,8 +381,20 @@ impl<L: SamplerLanes, const SPHERES: bool> BsdfVisitor for Batch<'_, '_, '_, L, 
         if B::DELTA {
             return;
         }
-        let kernel = self.x.kernel;
-        kernel.shade_batch_out_of_line::<B, L, SPHERES>(self.x, self.out)
+        let Lanes {
+            kernel,
+            tables,
+            h,
+            rng,
+            at_hit,
+            pre,
+            draws,
+            o,
+            ..
+        } = self.x;
+        kernel.shade_batch_out_of_line::<B, L, SPHERES>(
+            tables, h, rng, at_hit, pre, draws, o, self.out,
+        )
     }
 }
 

@@ -561,22 +561,53 @@ impl LaneKernel<'_> {
         self.paths.note(x.h.uniform as usize ^ 1, 1);
         match x.h.uniform {
             true => x.with(|_| &first).run(out),
-            false => self.shade_mixed::<B, L, SPHERES>(x, first, out),
+            false => {
+                let Lanes {
+                    tables,
+                    h,
+                    rng,
+                    at_hit,
+                    pre,
+                    draws,
+                    o,
+                    ..
+                } = x;
+                self.shade_mixed::<B, L, SPHERES>(tables, h, rng, at_hit, pre, draws, o, first, out)
+            }
         }
     }
 
-    /// `shade_batch`, out of line (see `li_lanes`).
+    /// `shade_batch`, out of line (see `li_lanes`). Its arrays are separate reference
+    /// arguments, as `shade_mixed`'s: passed gathered in one structure (`Lanes`) they lose
+    /// `noalias`, and the shading loops stopped compiling to vector code (Veach 0.7x).
     #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn shade_batch_out_of_line<
-        'k,
         B: Bsdf + Registered,
         L: SamplerLanes,
         const SPHERES: bool,
     >(
-        &'k self,
-        x: Lanes<'k, '_, (), L, SPHERES>,
+        &self,
+        tables: &LaneTables,
+        h: &CameraHits,
+        rng: &mut L,
+        at_hit: &L,
+        pre: Pre,
+        draws: &mut LightDraws,
+        o: &mut Shaded,
         out: &mut [Rgb; LANES],
     ) {
+        let x = Lanes::<(), L, SPHERES> {
+            kernel: self,
+            tables,
+            b: (),
+            h,
+            rng,
+            at_hit,
+            pre,
+            draws,
+            o,
+        };
         self.shade_batch::<B, L, SPHERES>(x, out)
     }
 
@@ -584,12 +615,30 @@ impl LaneKernel<'_> {
     /// line, so that the instance for one material, which nearly every batch takes,
     /// compiles as it would alone.
     #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
     fn shade_mixed<B: Bsdf + Registered, L: SamplerLanes, const SPHERES: bool>(
         &self,
-        x: Lanes<'_, '_, (), L, SPHERES>,
+        tables: &LaneTables,
+        h: &CameraHits,
+        rng: &mut L,
+        at_hit: &L,
+        pre: Pre,
+        draws: &mut LightDraws,
+        o: &mut Shaded,
         first: B,
         out: &mut [Rgb; LANES],
     ) {
+        let x = Lanes::<(), L, SPHERES> {
+            kernel: self,
+            tables,
+            b: (),
+            h,
+            rng,
+            at_hit,
+            pre,
+            draws,
+            o,
+        };
         let materials = &self.direct.scene.materials;
         // Each lane's BSDF; the first material's for lanes not covered.
         let mut b = [first; LANES];
