@@ -124,11 +124,30 @@ pub struct LaneScratch {
 #[derive(Default)]
 pub(crate) struct Paths(pub(crate) [std::sync::atomic::AtomicU64; Paths::N]);
 
+/// A path `Paths` counts.
+#[cfg(test)]
+#[derive(Clone, Copy)]
+pub(crate) enum Path {
+    /// A batch of one material.
+    UniformBatch,
+    /// A batch of several materials of one BSDF type.
+    MixedBatch,
+    /// A lane finished by `li_hit`.
+    ScalarLane,
+    /// A light step that read the lane tables.
+    TableLights,
+    /// A light step that drew each lane's light with `Direct::candidate`.
+    PerLaneLights,
+    /// Numbers drawn for some covered lanes only.
+    MaskedDraw,
+    /// A per-lane choice of technique.
+    Split,
+}
+
 #[cfg(test)]
 impl Paths {
     const N: usize = 7;
-    /// Batches of one material, of several, lanes finished by `li_hit`, light steps from the
-    /// tables, light steps lane by lane, draws for some lanes only, technique splits.
+    /// The paths' names, in `Path`'s order.
     pub(crate) const NAMES: [&str; Paths::N] = [
         "uniform batch",
         "mixed batch",
@@ -138,8 +157,8 @@ impl Paths {
         "masked draw",
         "split",
     ];
-    pub(crate) fn note(&self, what: usize, n: u64) {
-        self.0[what].fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+    pub(crate) fn note(&self, what: Path, n: u64) {
+        self.0[what as usize].fetch_add(n, std::sync::atomic::Ordering::Relaxed);
     }
     /// The counts by name.
     pub(crate) fn counts(&self) -> Vec<(&'static str, u64)> {
@@ -159,8 +178,8 @@ pub struct LaneKernel<'a> {
     pub(crate) paths: Paths,
     /// The scalar estimator, for the samples the lanes do not cover.
     pub direct: Direct<'a>,
-    /// The tables the lanes read (None: every sample takes the scalar path).
-    tables: Option<LaneTables<'a>>,
+    /// The tables the lanes read.
+    tables: LaneTables<'a>,
     /// The estimator's first call, whose numbers `li_lanes` draws before tracing.
     first: First,
 }
@@ -169,11 +188,7 @@ impl<'a> LaneKernel<'a> {
     /// The estimator of `strategy` on `scene`, with its lane tables.
     pub fn new(scene: &'a crate::scene::Scene, strategy: Strategy) -> Self {
         let direct = Direct::new(scene, strategy);
-        let tables = Some(tables::lane_setup(
-            scene,
-            &direct.strategy,
-            &direct.selector,
-        ));
+        let tables = tables::lane_setup(scene, &direct.strategy, &direct.selector);
         // RIS draws its candidates lane by lane from each lane's sampler.
         let first = match direct.ris {
             Some(_) => First::Other,
@@ -188,21 +203,8 @@ impl<'a> LaneKernel<'a> {
         }
     }
 
-    /// The same estimator shading every sample with `Direct::li`, one at a time: the
-    /// per-sample definition the lanes are tested against, and the baseline the bench
-    /// compares them with.
-    pub fn scalar(scene: &'a crate::scene::Scene, strategy: Strategy) -> Self {
-        LaneKernel {
-            #[cfg(test)]
-            paths: Paths::default(),
-            direct: Direct::new(scene, strategy),
-            tables: None,
-            first: First::Other,
-        }
-    }
-
     /// `li` of the first `n` rays, each with its lane of `rng` (which must stand where `li`
-    /// would receive it): in lanes where they cover the scene and strategy, else one by one.
+    /// would receive it): in lanes, but for the hits the module comment leaves to `li_hit`.
     ///
     /// Inlined into `render_pixel`: called, it read the lanes' generator states (left by the
     /// camera's draws half in one 32-byte store, half in 8-byte ones) and returned the
@@ -215,13 +217,7 @@ impl<'a> LaneKernel<'a> {
         rng: &mut L,
         scratch: &mut LaneScratch,
     ) -> [Rgb; LANES] {
-        let direct = &self.direct;
-        let Some(tables) = &self.tables else {
-            return std::array::from_fn(|i| match i < n {
-                true => direct.li(&rays.ray(i), &mut rng.lane(i)),
-                false => Rgb::ZERO,
-            });
-        };
+        let (direct, tables) = (&self.direct, &self.tables);
         let LaneScratch {
             hits,
             draws,
@@ -241,10 +237,9 @@ impl<'a> LaneKernel<'a> {
         let kind = &scene.materials[hits.first as usize].kind;
         macro_rules! lanes {
             ($spheres:literal) => {
-                Lanes::<(), L, $spheres> {
+                Lanes::<L, $spheres> {
                     kernel: self,
                     tables,
-                    b: (),
                     h: hits,
                     rng,
                     at_hit: &at_hit,
@@ -271,11 +266,6 @@ impl<'a> LaneKernel<'a> {
             }),
         }
         out
-    }
-
-    /// Whether `li_lanes` shades in lanes for this scene and strategy.
-    pub fn has_lanes(&self) -> bool {
-        self.tables.is_some()
     }
 
     /// The camera rays' hits into lanes; lanes the kernel does not cover are finished here
@@ -312,7 +302,7 @@ impl<'a> LaneKernel<'a> {
                 .is_some_and(|m| m.key == batch.get_or_insert(m).key);
             if !covered {
                 #[cfg(test)]
-                self.paths.note(2, 1);
+                self.paths.note(Path::ScalarLane, 1);
                 out[i] = direct.li_hit(&rays.ray(i), &camera.point(i), &mut rng.lane(i));
                 continue;
             }
@@ -368,7 +358,7 @@ impl<'a> LaneKernel<'a> {
 
 /// A batch handed to the code of its BSDF type (`BsdfKind::visit`).
 struct Batch<'k, 'a, 'o, L: SamplerLanes, const SPHERES: bool> {
-    x: Lanes<'k, 'a, (), L, SPHERES>,
+    x: Lanes<'k, 'a, L, SPHERES>,
     out: &'o mut [Rgb; LANES],
 }
 

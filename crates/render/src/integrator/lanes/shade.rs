@@ -11,6 +11,8 @@
 
 use super::light::light_sample;
 use super::tables::LaneTables;
+#[cfg(test)]
+use super::Path;
 use super::{mask_of, CameraHits, LaneKernel, LightDraws, Shaded, SphereDraws};
 use crate::bsdf::{Bsdf, BsdfSample, Material, Registered};
 use crate::geometry::ray_packet::bits;
@@ -64,13 +66,12 @@ struct LaneLight {
     target: Vec3,
 }
 
-/// The techniques for the covered lanes of a batch whose BSDFs have type `B` (lane i's is
-/// `b(i)`), with the sampler lanes `rng` standing after the camera's numbers (or after
-/// `pre`'s) and `at_hit` a copy of them from before `pre`.
-pub(super) struct Lanes<'k, 'a, F, L: SamplerLanes, const SPHERES: bool> {
+/// A batch's working state, for the techniques of its covered lanes: the sampler lanes
+/// `rng` standing after the camera's numbers (or after `pre`'s) and `at_hit` a copy of them
+/// from before `pre`.
+pub(super) struct Lanes<'k, 'a, L: SamplerLanes, const SPHERES: bool> {
     pub(super) kernel: &'k LaneKernel<'a>,
     pub(super) tables: &'k LaneTables<'a>,
-    pub(super) b: F,
     pub(super) h: &'k CameraHits,
     pub(super) rng: &'k mut L,
     pub(super) at_hit: &'k L,
@@ -79,21 +80,17 @@ pub(super) struct Lanes<'k, 'a, F, L: SamplerLanes, const SPHERES: bool> {
     pub(super) o: &'k mut Shaded,
 }
 
-impl<'k, 'a, B, F, L, const SPHERES: bool> Lanes<'k, 'a, F, L, SPHERES>
-where
-    B: Bsdf + 'k,
-    F: Fn(usize) -> &'k B + Copy,
-    L: SamplerLanes,
-{
-    /// Runs the strategy's estimator for the covered lanes and writes their estimates to
-    /// `out`.
+impl<'k, 'a, L: SamplerLanes, const SPHERES: bool> Lanes<'k, 'a, L, SPHERES> {
+    /// Runs the strategy's estimator for the covered lanes, lane i with BSDF `b(i)` (all of
+    /// type `B`), and writes their estimates to `out`.
     #[inline(always)]
-    pub(super) fn run(self, out: &mut [Rgb; LANES]) {
+    fn run<'b, B: Bsdf + 'b>(self, b: impl Fn(usize) -> &'b B + Copy, out: &mut [Rgb; LANES]) {
         let h = self.h;
         let mut t = Techniques8 {
-            setup: setup(self.b, h),
+            setup: setup(b, h),
             l: h.le,
             lanes: self,
+            b,
         };
         strategies::li(&mut t, false);
         for i in bits(h.covered) {
@@ -102,17 +99,18 @@ where
     }
 }
 
-/// `Lanes` with its per-batch setup and its estimates so far.
+/// `Lanes` with its lanes' BSDFs, its per-batch setup and its estimates so far.
 struct Techniques8<'k, 'a, F, L: SamplerLanes, const SPHERES: bool> {
-    lanes: Lanes<'k, 'a, F, L, SPHERES>,
+    lanes: Lanes<'k, 'a, L, SPHERES>,
+    b: F,
     setup: Setup,
     l: V3x8,
 }
 
-impl<'k, B, F, L, const SPHERES: bool> Techniques8<'k, '_, F, L, SPHERES>
+impl<'b, B, F, L, const SPHERES: bool> Techniques8<'_, '_, F, L, SPHERES>
 where
-    B: Bsdf + 'k,
-    F: Fn(usize) -> &'k B + Copy,
+    B: Bsdf + 'b,
+    F: Fn(usize) -> &'b B + Copy,
     L: SamplerLanes,
 {
     /// `pre`'s numbers if the call that wants them is the first and runs for every lane
@@ -140,7 +138,9 @@ where
         let x = &mut self.lanes;
         let h = x.h;
         #[cfg(test)]
-        x.kernel.paths.note(5, (h.covered & !live != 0) as u64);
+        x.kernel
+            .paths
+            .note(Path::MaskedDraw, (h.covered & !live != 0) as u64);
         let direct = &x.kernel.direct;
         if direct.ris.is_some() {
             let mut u = [[0.0; LANES]; 4];
@@ -155,7 +155,9 @@ where
     fn bsdf_numbers(&mut self, live: u32) -> [[f32; LANES]; 3] {
         let x = &mut self.lanes;
         #[cfg(test)]
-        x.kernel.paths.note(5, (x.h.covered & !live != 0) as u64);
+        x.kernel
+            .paths
+            .note(Path::MaskedDraw, (x.h.covered & !live != 0) as u64);
         masked(x.rng, live, x.h.covered, |r| r.bsdf())
     }
 }
@@ -186,10 +188,10 @@ fn add(l: &mut V3x8, x: &V3x8, lit: u32, m: u32, n: f32) {
     }
 }
 
-impl<'k, B, F, L, const SPHERES: bool> Techniques for Techniques8<'k, '_, F, L, SPHERES>
+impl<'b, B, F, L, const SPHERES: bool> Techniques for Techniques8<'_, '_, F, L, SPHERES>
 where
-    B: Bsdf + 'k,
-    F: Fn(usize) -> &'k B + Copy,
+    B: Bsdf + 'b,
+    F: Fn(usize) -> &'b B + Copy,
     L: SamplerLanes,
 {
     type Mask = u32;
@@ -227,7 +229,7 @@ where
         let x = &mut self.lanes;
         let (h, s) = (x.h, &self.setup);
         shade_light::<B, SPHERES>(
-            x.kernel, x.tables, x.b, h, s, &u, x.draws, x.o, live, weight,
+            x.kernel, x.tables, self.b, h, s, &u, x.draws, x.o, live, weight,
         );
         let lit = trace_light(x.kernel.direct.scene, h, x.o, live);
         add(&mut self.l, &x.o.light, lit, live, n);
@@ -244,7 +246,7 @@ where
             None => self.bsdf_numbers(live),
         };
         let x = &mut self.lanes;
-        shade_bsdf(x.b, x.h, &self.setup, &u, x.o, live);
+        shade_bsdf(self.b, x.h, &self.setup, &u, x.o, live);
         let bsdf = trace_bsdf::<SPHERES>(&x.kernel.direct, x.h, x.o, live, weight);
         add(&mut self.l, &bsdf, !0, live, n);
     }
@@ -273,7 +275,7 @@ where
         shade_light::<B, SPHERES>(
             k,
             x.tables,
-            x.b,
+            self.b,
             h,
             s,
             &ul,
@@ -282,7 +284,7 @@ where
             live,
             light_weight,
         );
-        shade_bsdf(x.b, h, s, &ub, x.o, live);
+        shade_bsdf(self.b, h, s, &ub, x.o, live);
         let lit = trace_light(k.direct.scene, h, x.o, live);
         let bsdf = trace_bsdf::<SPHERES>(&k.direct, h, x.o, live, bsdf_weight);
         add(&mut self.l, &x.o.light, lit, live, ne);
@@ -292,7 +294,7 @@ where
     #[inline(always)]
     fn split(&mut self, c: f32) -> (u32, u32) {
         #[cfg(test)]
-        self.lanes.kernel.paths.note(6, 1);
+        self.lanes.kernel.paths.note(Path::Split, 1);
         self.take_pre(false, false, false);
         let x = &mut self.lanes;
         let mut below = 0;
@@ -361,7 +363,13 @@ fn shade_light<'b, B: Bsdf + 'b, const SPHERES: bool>(
     let direct = &k.direct;
     let ris = direct.ris.is_some();
     #[cfg(test)]
-    k.paths.note(if tables.area { 3 } else { 4 }, 1);
+    k.paths.note(
+        match tables.area {
+            true => Path::TableLights,
+            false => Path::PerLaneLights,
+        },
+        1,
+    );
     if tables.area {
         let mut spheres = SphereDraws::default();
         let small = tables.small_lights.as_deref();
@@ -377,26 +385,24 @@ fn shade_light<'b, B: Bsdf + 'b, const SPHERES: bool>(
             &mut spheres,
         );
         let (ld, sd) = (&*ld, &spheres);
-        // `light_lane` spelled out for area lights (never delta): passed through its
-        // record, this loop stopped compiling to vector code.
         for i in 0..LANES {
             let sp = h.camera.point(i);
-            let (p, frame) = (sp.p, Frame::from_normal(sp.ns));
-            let (drawn, wl, pdf_area, radiance, lsp) = light_sample::<SPHERES>(p, ld, sd, u, i);
-            let wo = Material::mirror(s.flip[i], frame.to_local(wl));
-            let (f, pdf_bsdf) = b(i).eval_pdf_shared(s.wi.get(i), wo, s.shared[i]);
+            let (drawn, wi, pdf_area, li, lsp) = light_sample::<SPHERES>(sp.p, ld, sd, u, i);
             let p_light = ld.pmf[i] * pdf_area;
-            let w = weight(p_light, pdf_bsdf);
-            // RIS divides by its own density; the MIS weight takes pmf * pdf (see
-            // `LightDraw`).
-            let p_div = if ris { ld.p_div[i] } else { p_light };
-            o.light.set(i, f * radiance * (w / p_div));
-            o.light_ok[i] = drawn && f != Rgb::ZERO && radiance != Rgb::ZERO;
-            let lp = lsp.p;
-            let so = sp.spawn_origin(lp - p);
-            let target = lsp.spawn_origin(so - lp);
-            o.shadow
-                .set(i, &Scene::shadow_ray_to(so, target, h.skip[i]));
+            let origin = sp.spawn_origin(lsp.p - sp.p);
+            let light = LaneLight {
+                drawn,
+                wi,
+                p_light,
+                // RIS divides by its own density; the MIS weight takes pmf * pdf (see
+                // `LightDraw`).
+                p_div: if ris { ld.p_div[i] } else { p_light },
+                li,
+                delta: false,
+                origin,
+                target: lsp.spawn_origin(origin - lsp.p),
+            };
+            light_lane(b(i), s, i, &sp, h.skip[i], &light, weight, o);
         }
         return;
     }
@@ -551,16 +557,22 @@ impl LaneKernel<'_> {
     #[inline(always)]
     pub(super) fn shade_batch<'k, B: Bsdf + Registered, L: SamplerLanes, const SPHERES: bool>(
         &'k self,
-        x: Lanes<'k, '_, (), L, SPHERES>,
+        x: Lanes<'k, '_, L, SPHERES>,
         out: &mut [Rgb; LANES],
     ) {
         let materials = &self.direct.scene.materials;
         let first = *B::view(&materials[x.h.first as usize].kind)
             .expect("the batch's first material has the batch's type");
         #[cfg(test)]
-        self.paths.note(x.h.uniform as usize ^ 1, 1);
+        self.paths.note(
+            match x.h.uniform {
+                true => Path::UniformBatch,
+                false => Path::MixedBatch,
+            },
+            1,
+        );
         match x.h.uniform {
-            true => x.with(|_| &first).run(out),
+            true => x.run(|_| &first, out),
             false => {
                 let Lanes {
                     tables,
@@ -597,10 +609,9 @@ impl LaneKernel<'_> {
         o: &mut Shaded,
         out: &mut [Rgb; LANES],
     ) {
-        let x = Lanes::<(), L, SPHERES> {
+        let x = Lanes::<L, SPHERES> {
             kernel: self,
             tables,
-            b: (),
             h,
             rng,
             at_hit,
@@ -628,10 +639,9 @@ impl LaneKernel<'_> {
         first: B,
         out: &mut [Rgb; LANES],
     ) {
-        let x = Lanes::<(), L, SPHERES> {
+        let x = Lanes::<L, SPHERES> {
             kernel: self,
             tables,
-            b: (),
             h,
             rng,
             at_hit,
@@ -645,27 +655,6 @@ impl LaneKernel<'_> {
         for i in bits(x.h.covered) {
             b[i] = *B::view(&materials[x.h.material[i] as usize].kind).unwrap_or(&first);
         }
-        x.with(|i| &b[i]).run(out)
-    }
-}
-
-impl<'k, 'a, L: SamplerLanes, const SPHERES: bool> Lanes<'k, 'a, (), L, SPHERES> {
-    /// The batch with lane i's BSDF `b(i)`.
-    #[inline(always)]
-    fn with<'r, F>(self, b: F) -> Lanes<'r, 'a, F, L, SPHERES>
-    where
-        'k: 'r,
-    {
-        Lanes {
-            kernel: self.kernel,
-            tables: self.tables,
-            b,
-            h: self.h,
-            rng: self.rng,
-            at_hit: self.at_hit,
-            pre: self.pre,
-            draws: self.draws,
-            o: self.o,
-        }
+        x.run(|i| &b[i], out)
     }
 }
