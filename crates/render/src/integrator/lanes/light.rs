@@ -361,7 +361,7 @@ mod tests {
                     .unwrap();
                 let kernel = super::super::LaneKernel::new(&scene, strategy);
                 let lanes = &kernel.tables;
-                assert!(lanes.area, "tables");
+                assert!(lanes.area(), "tables");
                 let selector = &kernel.direct.selector;
                 let small = lanes.small_lights.as_deref().expect("two to eight lights");
                 let n = scene.emitters.len() as f32;

@@ -39,6 +39,7 @@
 
 mod light;
 mod shade;
+mod steps;
 mod tables;
 #[cfg(test)]
 mod tests;

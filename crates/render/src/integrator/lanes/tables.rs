@@ -175,12 +175,9 @@ pub(super) struct LaneShape {
 
 /// The tables of the lanes: one light per emitter, one record per shape.
 pub(super) struct LaneTables<'a> {
-    /// Whether the lanes draw light samples from `lights` (area sampling, every emitter an
-    /// area light on a mesh or a sphere); otherwise with `Direct::candidate`, lane by lane.
-    pub(super) area: bool,
     /// Whether some emitter is a sphere (the lanes then test for sphere lights).
     pub(super) spheres: bool,
-    /// One per emitter, where `area`.
+    /// One per emitter, where the lanes draw light samples from them (`area`).
     pub(super) lights: Vec<LaneLight<'a>>,
     pub(super) shapes: Vec<LaneShape>,
     /// The emitter choice in lane form, for two to eight emitters.
@@ -235,15 +232,22 @@ impl SmallLights {
     }
 }
 
+impl LaneTables<'_> {
+    /// Whether the lanes draw light samples from `lights` (area sampling, every emitter an
+    /// area light on a mesh or a sphere); otherwise with `Direct::candidate`, lane by lane.
+    #[inline(always)]
+    pub(super) fn area(&self) -> bool {
+        !self.lights.is_empty()
+    }
+}
+
 /// The lanes' tables for the scene and strategy.
 pub(super) fn lane_setup<'a>(
     scene: &'a Scene,
     s: &Strategy,
     selector: &EmitterSelector,
 ) -> LaneTables<'a> {
-    let lights = lane_lights(scene, s);
-    let area = lights.is_some();
-    let lights = lights.unwrap_or_default();
+    let lights = lane_lights(scene, s).unwrap_or_default();
     let small_lights = SmallLights::new(&lights, selector).map(Box::new);
     let spheres = scene.emitters.iter().any(|e| match e {
         Emitter::Area(light) => {
@@ -275,7 +279,6 @@ pub(super) fn lane_setup<'a>(
         })
         .collect();
     LaneTables {
-        area,
         spheres,
         lights,
         shapes,
@@ -325,11 +328,12 @@ mod tests {
     use crate::geometry::{Accel, SurfacePoint};
     use crate::integrator::Strategy;
     use crate::scene::bundled_tests::load;
+    use crate::scene::desc::StrategyKind;
 
     fn mis() -> Strategy {
         Strategy::combinations()
             .into_iter()
-            .find(|s| s.kind == crate::scene::desc::StrategyKind::Mis && s.emitter_samples == 1)
+            .find(|s| s.kind == StrategyKind::Mis && s.emitter_samples == 1)
             .unwrap()
     }
 
@@ -350,7 +354,7 @@ mod tests {
                 &mis(),
                 &EmitterSelector::new(&scene.emitters, &scene.shapes, mis().selection),
             );
-            assert!(lanes.area, "{rel}: tables");
+            assert!(lanes.area(), "{rel}: tables");
             assert_eq!(lanes.shapes.len(), scene.shapes.len());
             // Rows by (lanes shade it, two-sided).
             let mut kinds = [[0; 2]; 2];
@@ -421,7 +425,7 @@ mod tests {
             &mis(),
             &EmitterSelector::new(&scene.emitters, &scene.shapes, mis().selection),
         );
-        assert!(lanes.area);
+        assert!(lanes.area());
         let mut checked = 0;
         for (light, e) in lanes.lights.iter().zip(&scene.emitters) {
             let LaneLightKind::Mesh {
