@@ -7,13 +7,14 @@
 // over one of them would hide that symmetry.
 #![allow(clippy::needless_range_loop)]
 
-use super::steps::{ris_numbers, setup, shade_bsdf, shade_light, trace_bsdf, trace_light, Setup};
+use super::steps::{bsdf_step, light_step, pair_step, ris_numbers, setup, Setup};
 use super::tables::LaneTables;
 #[cfg(test)]
 use super::Path;
 use super::{CameraHits, LaneKernel, LightDraws, Shaded};
 use crate::bsdf::{Bsdf, Registered};
 use crate::geometry::ray_packet::bits;
+use crate::integrator::direct::Weight;
 use crate::integrator::strategies::{self, First, Techniques};
 use crate::integrator::Strategy;
 use crate::math::{Rgb, V3x8};
@@ -54,13 +55,13 @@ pub(super) struct Lanes<'k, 'a, L: SamplerLanes, const SPHERES: bool> {
 }
 
 impl<'k, 'a, L: SamplerLanes, const SPHERES: bool> Lanes<'k, 'a, L, SPHERES> {
-    /// Runs the strategy's estimator for the covered lanes, lane i with BSDF `b(i)` (all of
-    /// type `B`), and writes their estimates to `out`.
+    /// Runs the strategy's estimator for the covered lanes, lane i with BSDF `b[i]` (all of
+    /// type `B`; `b[0]` for all if `U`, see `lane_bsdf`), and writes their estimates to `out`.
     #[inline(always)]
-    fn run<'b, B: Bsdf + 'b>(self, b: impl Fn(usize) -> &'b B + Copy, out: &mut [Rgb; LANES]) {
+    fn run<B: Bsdf, const U: bool>(self, b: &[B; LANES], out: &mut [Rgb; LANES]) {
         let h = self.h;
-        let mut t = Techniques8 {
-            setup: setup(b, h),
+        let mut t = Techniques8::<B, L, SPHERES, U> {
+            setup: setup::<B, U>(b, h),
             l: h.le,
             lanes: self,
             b,
@@ -73,18 +74,15 @@ impl<'k, 'a, L: SamplerLanes, const SPHERES: bool> Lanes<'k, 'a, L, SPHERES> {
 }
 
 /// `Lanes` with its lanes' BSDFs, its per-batch setup and its estimates so far.
-struct Techniques8<'k, 'a, F, L: SamplerLanes, const SPHERES: bool> {
+struct Techniques8<'k, 'a, B, L: SamplerLanes, const SPHERES: bool, const U: bool> {
     lanes: Lanes<'k, 'a, L, SPHERES>,
-    b: F,
+    b: &'k [B; LANES],
     setup: Setup,
     l: V3x8,
 }
 
-impl<'b, B, F, L, const SPHERES: bool> Techniques8<'_, '_, F, L, SPHERES>
-where
-    B: Bsdf + 'b,
-    F: Fn(usize) -> &'b B + Copy,
-    L: SamplerLanes,
+impl<B: Bsdf, L: SamplerLanes, const SPHERES: bool, const U: bool>
+    Techniques8<'_, '_, B, L, SPHERES, U>
 {
     /// `pre`'s numbers if the call that wants them is the first and runs for every lane
     /// (`light`, `bsdf`: which numbers it draws); otherwise None, with `rng` put back to
@@ -161,11 +159,8 @@ fn add(l: &mut V3x8, x: &V3x8, lit: u32, m: u32, n: f32) {
     }
 }
 
-impl<'b, B, F, L, const SPHERES: bool> Techniques for Techniques8<'_, '_, F, L, SPHERES>
-where
-    B: Bsdf + 'b,
-    F: Fn(usize) -> &'b B + Copy,
-    L: SamplerLanes,
+impl<B: Bsdf, L: SamplerLanes, const SPHERES: bool, const U: bool> Techniques
+    for Techniques8<'_, '_, B, L, SPHERES, U>
 {
     type Mask = u32;
 
@@ -190,7 +185,7 @@ where
     }
 
     #[inline(always)]
-    fn light(&mut self, m: u32, weight: impl Fn(f32, f32) -> f32 + Copy, n: f32) {
+    fn light(&mut self, m: u32, weight: Weight, n: f32) {
         let live = m & self.lanes.h.covered;
         if live == 0 {
             return;
@@ -200,16 +195,14 @@ where
             None => self.light_numbers(live),
         };
         let x = &mut self.lanes;
-        let (h, s) = (x.h, &self.setup);
-        shade_light::<B, SPHERES>(
-            x.kernel, x.tables, self.b, h, s, &u, x.draws, x.o, live, weight,
-        );
-        let lit = trace_light(x.kernel.direct.scene, h, x.o, live);
+        let (k, h, s) = (x.kernel, x.h, &self.setup);
+        let lit =
+            light_step::<B, SPHERES, U>(k, x.tables, self.b, h, s, &u, x.draws, x.o, live, weight);
         add(&mut self.l, &x.o.light, lit, live, n);
     }
 
     #[inline(always)]
-    fn bsdf(&mut self, m: u32, weight: impl Fn(f32, f32) -> f32 + Copy, n: f32) {
+    fn bsdf(&mut self, m: u32, weight: Weight, n: f32) {
         let live = m & self.lanes.h.covered;
         if live == 0 {
             return;
@@ -219,19 +212,13 @@ where
             None => self.bsdf_numbers(live),
         };
         let x = &mut self.lanes;
-        shade_bsdf(self.b, x.h, &self.setup, &u, x.o, live);
-        let bsdf = trace_bsdf::<SPHERES>(&x.kernel.direct, x.h, x.o, live, weight);
+        let (k, h, s) = (x.kernel, x.h, &self.setup);
+        let bsdf = bsdf_step::<B, SPHERES, U>(k, self.b, h, s, &u, x.o, live, weight);
         add(&mut self.l, &bsdf, !0, live, n);
     }
 
     #[inline(always)]
-    fn light_and_bsdf(
-        &mut self,
-        light_weight: impl Fn(f32, f32) -> f32 + Copy,
-        ne: f32,
-        bsdf_weight: impl Fn(f32, f32) -> f32 + Copy,
-        nb: f32,
-    ) {
+    fn light_and_bsdf(&mut self, light_weight: Weight, ne: f32, bsdf_weight: Weight, nb: f32) {
         let live = self.lanes.h.covered;
         let (ul, ub) = match self.take_pre(true, true, true) {
             Some(pre) => (
@@ -245,21 +232,19 @@ where
         };
         let x = &mut self.lanes;
         let (k, h, s) = (x.kernel, x.h, &self.setup);
-        shade_light::<B, SPHERES>(
+        let (lit, bsdf) = pair_step::<B, SPHERES, U>(
             k,
             x.tables,
             self.b,
             h,
             s,
             &ul,
+            &ub,
             x.draws,
             x.o,
-            live,
             light_weight,
+            bsdf_weight,
         );
-        shade_bsdf(self.b, h, s, &ub, x.o, live);
-        let lit = trace_light(k.direct.scene, h, x.o, live);
-        let bsdf = trace_bsdf::<SPHERES>(&k.direct, h, x.o, live, bsdf_weight);
         add(&mut self.l, &x.o.light, lit, live, ne);
         add(&mut self.l, &bsdf, !0, live, nb);
     }
@@ -324,7 +309,7 @@ impl LaneKernel<'_> {
             1,
         );
         match x.h.uniform {
-            true => x.run(|_| &first, out),
+            true => x.run::<B, true>(&[first; LANES], out),
             false => {
                 let Lanes {
                     tables,
@@ -407,6 +392,6 @@ impl LaneKernel<'_> {
         for i in bits(x.h.covered) {
             b[i] = *B::view(&materials[x.h.material[i] as usize].kind).unwrap_or(&first);
         }
-        x.run(|i| &b[i], out)
+        x.run::<B, false>(&b, out)
     }
 }

@@ -14,6 +14,7 @@ use super::Path;
 use super::{mask_of, CameraHits, LaneKernel, LightDraws, Shaded, SphereDraws};
 use crate::bsdf::{Bsdf, BsdfSample, Material};
 use crate::geometry::ray_packet::bits;
+use crate::integrator::direct::{by_weight, Weight};
 use crate::integrator::Direct;
 use crate::math::{Frame, Rgb, V3x8};
 use crate::rng::LANES;
@@ -44,16 +45,98 @@ pub(super) struct LaneLight {
     pub(super) target: Vec3,
 }
 
+/// Lane i's BSDF of the batch's `b`: `b[0]` for every lane of a batch of one material
+/// (`U`), where the compiler then reads its parameters once for all lanes.
+#[inline(always)]
+pub(super) fn lane_bsdf<B, const U: bool>(b: &[B; LANES], i: usize) -> &B {
+    if U {
+        &b[0]
+    } else {
+        &b[i]
+    }
+}
+
+/// A light sample at the lanes of `live` with numbers `u`, shaded and traced: each lane's
+/// term in `o.light`, and the mask of those that reach their light. Out of line, as the
+/// other two steps: one instance per BSDF type serves every estimator and sampler (inlined
+/// into each of their call sites, the renderer's release build took 113 s instead of 21).
+#[inline(never)]
+#[allow(clippy::too_many_arguments)] // the lanes' arrays, each its own argument (see `LaneScratch`)
+pub(super) fn light_step<B: Bsdf, const SPHERES: bool, const U: bool>(
+    k: &LaneKernel,
+    tables: &LaneTables,
+    b: &[B; LANES],
+    h: &CameraHits,
+    s: &Setup,
+    u: &[[f32; LANES]; 4],
+    ld: &mut LightDraws,
+    o: &mut Shaded,
+    live: u32,
+    weight: Weight,
+) -> u32 {
+    by_weight!(weight, |w| shade_light::<B, SPHERES, U>(
+        k, tables, b, h, s, u, ld, o, live, w
+    ));
+    trace_light(k.direct.scene, h, o, live)
+}
+
+/// A BSDF sample at the lanes of `live` with numbers `u`, shaded and traced: each lane's
+/// weighted emission (zero where none is reached).
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn bsdf_step<B: Bsdf, const SPHERES: bool, const U: bool>(
+    k: &LaneKernel,
+    b: &[B; LANES],
+    h: &CameraHits,
+    s: &Setup,
+    u: &[[f32; LANES]; 3],
+    o: &mut Shaded,
+    live: u32,
+    weight: Weight,
+) -> V3x8 {
+    shade_bsdf::<B, U>(b, h, s, u, o, live);
+    trace_bsdf::<SPHERES>(&k.direct, h, o, live, weight)
+}
+
+/// `light_step` and then `bsdf_step` at every covered lane, both shaded before either traces
+/// its rays, so that their arithmetic overlaps instead of waiting behind a traversal.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn pair_step<B: Bsdf, const SPHERES: bool, const U: bool>(
+    k: &LaneKernel,
+    tables: &LaneTables,
+    b: &[B; LANES],
+    h: &CameraHits,
+    s: &Setup,
+    ul: &[[f32; LANES]; 4],
+    ub: &[[f32; LANES]; 3],
+    ld: &mut LightDraws,
+    o: &mut Shaded,
+    light_weight: Weight,
+    bsdf_weight: Weight,
+) -> (u32, V3x8) {
+    let live = h.covered;
+    by_weight!(light_weight, |w| shade_light::<B, SPHERES, U>(
+        k, tables, b, h, s, ul, ld, o, live, w
+    ));
+    shade_bsdf::<B, U>(b, h, s, ub, o, live);
+    let lit = trace_light(k.direct.scene, h, o, live);
+    (
+        lit,
+        trace_bsdf::<SPHERES>(&k.direct, h, o, live, bsdf_weight),
+    )
+}
+
 /// Each lane's `Setup`.
 #[inline(always)]
-pub(super) fn setup<'b, B: Bsdf + 'b>(b: impl Fn(usize) -> &'b B + Copy, h: &CameraHits) -> Setup {
+pub(super) fn setup<B: Bsdf, const U: bool>(b: &[B; LANES], h: &CameraHits) -> Setup {
     let mut s = Setup::default();
     for i in 0..LANES {
         let frame = Frame::from_normal(h.camera.point(i).ns);
         // `Material::eval_pdf`'s orientation, once for every sample of the hit.
         let (wi, flipped) = Material::side(h.two_sided, frame.to_local(-h.d.get(i)));
         s.wi.set(i, wi);
-        (s.shared[i], s.flip[i]) = (b(i).lane_shared(wi), flipped);
+        (s.shared[i], s.flip[i]) = (lane_bsdf::<B, U>(b, i).lane_shared(wi), flipped);
     }
     s
 }
@@ -65,10 +148,10 @@ pub(super) fn setup<'b, B: Bsdf + 'b>(b: impl Fn(usize) -> &'b B + Copy, h: &Cam
 /// lane's light with `Direct::candidate`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)] // the lanes' arrays, each its own argument (see `LaneScratch`)
-pub(super) fn shade_light<'b, B: Bsdf + 'b, const SPHERES: bool>(
+fn shade_light<B: Bsdf, const SPHERES: bool, const U: bool>(
     k: &LaneKernel,
     tables: &LaneTables,
-    b: impl Fn(usize) -> &'b B + Copy,
+    b: &[B; LANES],
     h: &CameraHits,
     s: &Setup,
     u: &[[f32; LANES]; 4],
@@ -119,7 +202,16 @@ pub(super) fn shade_light<'b, B: Bsdf + 'b, const SPHERES: bool>(
                 origin,
                 target: lsp.spawn_origin(origin - lsp.p),
             };
-            light_lane(b(i), s, i, &sp, h.skip[i], &light, weight, o);
+            light_lane(
+                lane_bsdf::<B, U>(b, i),
+                s,
+                i,
+                &sp,
+                h.skip[i],
+                &light,
+                weight,
+                o,
+            );
         }
         return;
     }
@@ -146,7 +238,16 @@ pub(super) fn shade_light<'b, B: Bsdf + 'b, const SPHERES: bool>(
             origin,
             target,
         };
-        light_lane(b(i), s, i, &sp, h.skip[i], &light, weight, o);
+        light_lane(
+            lane_bsdf::<B, U>(b, i),
+            s,
+            i,
+            &sp,
+            h.skip[i],
+            &light,
+            weight,
+            o,
+        );
     }
 }
 
@@ -177,7 +278,7 @@ pub(super) fn light_lane<B: Bsdf>(
 /// The shadow rays of the lanes of `live` with a possible term, as one packet: the mask of
 /// those that reach their light.
 #[inline(always)]
-pub(super) fn trace_light(scene: &Scene, h: &CameraHits, o: &Shaded, live: u32) -> u32 {
+fn trace_light(scene: &Scene, h: &CameraHits, o: &Shaded, live: u32) -> u32 {
     let traced = live & h.covered & mask_of(&o.light_ok);
     traced & !scene.accel.occluded8(&o.shadow, traced)
 }
@@ -185,15 +286,15 @@ pub(super) fn trace_light(scene: &Scene, h: &CameraHits, o: &Shaded, live: u32) 
 /// `bsdf_draw` (`Material::sample` with `Setup`'s orientation) and `bsdf_finish`'s ray, for
 /// the lanes of `live` with numbers `u`, in `o`.
 #[inline(always)]
-pub(super) fn shade_bsdf<'b, B: Bsdf + 'b>(
-    b: impl Fn(usize) -> &'b B + Copy,
+fn shade_bsdf<B: Bsdf, const U: bool>(
+    b: &[B; LANES],
     h: &CameraHits,
     s: &Setup,
     u: &[[f32; LANES]; 3],
     o: &mut Shaded,
     live: u32,
 ) {
-    let bs = B::sample_lanes(b, &s.wi, &s.shared, u, live);
+    let bs = B::sample_lanes(|i| lane_bsdf::<B, U>(b, i), &s.wi, &s.shared, u, live);
     for i in 0..LANES {
         let sp = h.camera.point(i);
         (o.bsdf_ok[i], o.bsdf_pdf[i], o.bsdf_delta[i]) = (bs.ok[i], bs.pdf[i], bs.delta[i]);
@@ -209,12 +310,12 @@ pub(super) fn shade_bsdf<'b, B: Bsdf + 'b>(
 /// (without sphere lights, its box reject alone); those it lets through are traced one by
 /// one. Each lane's weighted emission (zero where none is reached).
 #[inline(always)]
-pub(super) fn trace_bsdf<const SPHERES: bool>(
+fn trace_bsdf<const SPHERES: bool>(
     direct: &Direct,
     h: &CameraHits,
     o: &Shaded,
     live: u32,
-    weight: impl Fn(f32, f32) -> f32 + Copy,
+    weight: Weight,
 ) -> V3x8 {
     let scene = direct.scene;
     let rays = &o.bsdf;

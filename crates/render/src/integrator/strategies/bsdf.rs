@@ -1,6 +1,6 @@
 //! BSDF sampling alone (Nori's `material`): `bsdf_samples` BSDF samples per camera sample.
 
-use super::{Direct, Estimator, Techniques};
+use super::{Estimator, Techniques, Weight};
 use crate::integrator::Strategy;
 use crate::scene::desc::StrategyKind;
 
@@ -15,12 +15,12 @@ impl Estimator for Bsdf {
         let (n, all) = (t.strategy().bsdf_samples, t.all());
         let nb = n as f32;
         for _ in 0..n {
-            t.bsdf(all, |_, _| 1.0, nb);
+            t.bsdf(all, Weight::One, nb);
         }
         // Delta lights, which no BSDF sample hits: light samples for them alone.
         if t.has_delta_lights() && !delta_bsdf {
             for _ in 0..n {
-                t.light(all, Direct::only_other, nb);
+                t.light(all, Weight::OnlyOther, nb);
             }
         }
     }

@@ -1,6 +1,6 @@
 //! Light sampling alone (Nori's `light`): `emitter_samples` light samples per camera sample.
 
-use super::{Direct, Estimator, Techniques};
+use super::{Estimator, Techniques, Weight};
 use crate::integrator::Strategy;
 use crate::scene::desc::StrategyKind;
 
@@ -18,7 +18,7 @@ impl Estimator for Light {
             // A delta BSDF gives light samples zero throughput: its light arrives by BSDF
             // samples, one in place of each light sample.
             for _ in 0..n {
-                t.bsdf(all, Direct::only_other, ne);
+                t.bsdf(all, Weight::OnlyOther, ne);
             }
             return;
         }
@@ -26,9 +26,9 @@ impl Estimator for Light {
         // latter, and a BSDF sample each that counts only the delta lobe.
         let delta_lobe = t.has_delta_lobe();
         for _ in 0..n {
-            t.light(all, |_, _| 1.0, ne);
+            t.light(all, Weight::One, ne);
             if delta_lobe {
-                t.bsdf(all, Direct::only_other, ne);
+                t.bsdf(all, Weight::OnlyOther, ne);
             }
         }
     }

@@ -1,8 +1,7 @@
 //! Multi-sample MIS of `emitter_samples` light and `bsdf_samples` BSDF samples, each weighted
 //! by h(n_i p_i, n_j p_j) (Veach's balance or power heuristic).
 
-use super::{Estimator, Techniques};
-use crate::integrator::direct::heuristic;
+use super::{Estimator, Techniques, Weight};
 use crate::integrator::Strategy;
 use crate::scene::desc::StrategyKind;
 
@@ -16,11 +15,20 @@ impl Estimator for Mis {
     fn li<T: Techniques>(t: &mut T, delta_bsdf: bool) {
         let (s, all) = (*t.strategy(), t.all());
         let (ne, nb) = (s.emitter_samples as f32, s.bsdf_samples as f32);
-        let light_w = move |pl, pb| heuristic(s.heuristic, ne * pl, nb * pb);
+        let h = s.heuristic;
+        let light_w = Weight::Mis {
+            h,
+            own: ne,
+            other: nb,
+        };
         // A delta BSDF draws no light samples (they would add zero): BSDF samples then carry
         // weight 1.
         let ne_drawn = if delta_bsdf { 0.0 } else { ne };
-        let bsdf_w = move |pb, pl| heuristic(s.heuristic, nb * pb, ne_drawn * pl);
+        let bsdf_w = Weight::Mis {
+            h,
+            own: nb,
+            other: ne_drawn,
+        };
         let n_light = if delta_bsdf { 0 } else { s.emitter_samples };
         for _ in 1..n_light {
             t.light(all, light_w, ne);

@@ -2,8 +2,7 @@
 //! c = n_e / (n_e + n_b) (0 for a delta BSDF), else the BSDF technique, and weights by
 //! h(c_i p_i, c_j p_j) / c_i.
 
-use super::{Estimator, Techniques};
-use crate::integrator::direct::heuristic;
+use super::{Estimator, Techniques, Weight};
 use crate::integrator::Strategy;
 use crate::scene::desc::StrategyKind;
 
@@ -21,16 +20,19 @@ impl Estimator for MisOneSample {
         let c_bsdf = 1.0 - c_light;
         // Each hit takes one technique; its term is added undivided (x / 1 is x exactly).
         let (light, bsdf) = t.split(c_light);
-        t.light(
-            light,
-            move |pl, pb| heuristic(s.heuristic, c_light * pl, c_bsdf * pb) / c_light,
-            1.0,
-        );
-        t.bsdf(
-            bsdf,
-            move |pb, pl| heuristic(s.heuristic, c_bsdf * pb, c_light * pl) / c_bsdf,
-            1.0,
-        );
+        let h = s.heuristic;
+        let light_w = Weight::OneSample {
+            h,
+            own: c_light,
+            other: c_bsdf,
+        };
+        let bsdf_w = Weight::OneSample {
+            h,
+            own: c_bsdf,
+            other: c_light,
+        };
+        t.light(light, light_w, 1.0);
+        t.bsdf(bsdf, bsdf_w, 1.0);
     }
 
     fn label(_: &Strategy, h: &str, sel: &str, ls: &str) -> String {

@@ -14,7 +14,7 @@ mod mis;
 mod mis_onesample;
 mod techniques;
 
-use super::direct::Direct;
+use super::direct::{Direct, Weight};
 use super::Strategy;
 use crate::geometry::{Ray, SurfacePoint};
 use crate::math::Rgb;

@@ -4,7 +4,7 @@
 //! once (`lanes::shade`); `First` records which one an estimator calls first, so the lane
 //! kernel can draw its numbers before the camera rays are traced.
 
-use super::{Direct, Strategy};
+use super::{Direct, Strategy, Weight};
 use crate::integrator::direct::Shading;
 use crate::math::Rgb;
 use crate::sampler::Sampler;
@@ -23,19 +23,13 @@ pub(in crate::integrator) trait Techniques {
     /// Every hit being shaded.
     fn all(&self) -> Self::Mask;
     /// One light sample at each hit of `m`, weighted by `weight(p_light, p_bsdf)`.
-    fn light(&mut self, m: Self::Mask, weight: impl Fn(f32, f32) -> f32 + Copy, n: f32);
+    fn light(&mut self, m: Self::Mask, weight: Weight, n: f32);
     /// One BSDF sample at each hit of `m`, weighted by `weight(p_bsdf, p_light)`.
-    fn bsdf(&mut self, m: Self::Mask, weight: impl Fn(f32, f32) -> f32 + Copy, n: f32);
+    fn bsdf(&mut self, m: Self::Mask, weight: Weight, n: f32);
     /// A light sample and then a BSDF sample at every hit, both drawn before either traces
     /// its ray (random numbers in the same order as `light` then `bsdf`): their arithmetic
     /// then overlaps instead of waiting behind a traversal.
-    fn light_and_bsdf(
-        &mut self,
-        light_weight: impl Fn(f32, f32) -> f32 + Copy,
-        ne: f32,
-        bsdf_weight: impl Fn(f32, f32) -> f32 + Copy,
-        nb: f32,
-    );
+    fn light_and_bsdf(&mut self, light_weight: Weight, ne: f32, bsdf_weight: Weight, nb: f32);
     /// Draws each hit's technique number: the hits where it is below `c`, and the rest.
     fn split(&mut self, c: f32) -> (Self::Mask, Self::Mask);
 }
@@ -84,27 +78,21 @@ impl<S: Sampler> Techniques for One<'_, '_, '_, S> {
     }
 
     #[inline(always)]
-    fn light(&mut self, m: bool, weight: impl Fn(f32, f32) -> f32 + Copy, n: f32) {
+    fn light(&mut self, m: bool, weight: Weight, n: f32) {
         if m {
             self.l += self.d.light_sample(self.sh, self.rng, weight) / n;
         }
     }
 
     #[inline(always)]
-    fn bsdf(&mut self, m: bool, weight: impl Fn(f32, f32) -> f32 + Copy, n: f32) {
+    fn bsdf(&mut self, m: bool, weight: Weight, n: f32) {
         if m {
             self.l += self.d.bsdf_sample(self.sh, self.rng, weight) / n;
         }
     }
 
     #[inline(always)]
-    fn light_and_bsdf(
-        &mut self,
-        light_weight: impl Fn(f32, f32) -> f32 + Copy,
-        ne: f32,
-        bsdf_weight: impl Fn(f32, f32) -> f32 + Copy,
-        nb: f32,
-    ) {
+    fn light_and_bsdf(&mut self, light_weight: Weight, ne: f32, bsdf_weight: Weight, nb: f32) {
         let (d, sh) = (self.d, self.sh);
         let light = d.light_draw(sh, self.rng);
         let bsdf = d.bsdf_draw(sh, self.rng);
@@ -164,21 +152,15 @@ impl Techniques for Recorder {
         true
     }
 
-    fn light(&mut self, m: bool, _: impl Fn(f32, f32) -> f32 + Copy, _: f32) {
+    fn light(&mut self, m: bool, _: Weight, _: f32) {
         self.note(if m { First::Light } else { First::Other });
     }
 
-    fn bsdf(&mut self, m: bool, _: impl Fn(f32, f32) -> f32 + Copy, _: f32) {
+    fn bsdf(&mut self, m: bool, _: Weight, _: f32) {
         self.note(if m { First::Bsdf } else { First::Other });
     }
 
-    fn light_and_bsdf(
-        &mut self,
-        _: impl Fn(f32, f32) -> f32 + Copy,
-        _: f32,
-        _: impl Fn(f32, f32) -> f32 + Copy,
-        _: f32,
-    ) {
+    fn light_and_bsdf(&mut self, _: Weight, _: f32, _: Weight, _: f32) {
         self.note(First::LightAndBsdf);
     }
 
