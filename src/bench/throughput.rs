@@ -15,17 +15,23 @@ pub(super) fn section(scene: &Scene, name: &str, a: &BenchArgs, rows: &mut Vec<R
         let by_threads: Vec<(usize, Timed)> = a.threads.iter().copied().zip(all).collect();
         for &(threads, ref timed) in &by_threads {
             println!(
-                "  {:<34} {:<26} {:>7} {:>12.2}  {:.2} ({:.0}% below)",
+                "  {:<34} {:<26} {:>7} {:>12.2}  {:.2} ({:.0}% below)  {:.2} rays/sample",
                 name,
                 strategy.label(),
                 threads,
                 timed.samples_per_s / 1e6,
                 timed.slowest_samples_per_s / 1e6,
                 (1.0 - timed.slowest_samples_per_s / timed.samples_per_s) * 100.0,
+                timed.rays_per_sample(),
             );
-            for (section, value) in [
-                ("throughput", timed.samples_per_s),
-                ("throughput_slowest", timed.slowest_samples_per_s),
+            for (section, value, unit) in [
+                ("throughput", timed.samples_per_s, "samples/s"),
+                (
+                    "throughput_slowest",
+                    timed.slowest_samples_per_s,
+                    "samples/s",
+                ),
+                ("rays_per_sample", timed.rays_per_sample(), "rays/sample"),
             ] {
                 rows.push(Row {
                     section,
@@ -34,7 +40,7 @@ pub(super) fn section(scene: &Scene, name: &str, a: &BenchArgs, rows: &mut Vec<R
                     threads,
                     n: 0,
                     value,
-                    unit: "samples/s",
+                    unit,
                 });
             }
         }

@@ -2,6 +2,7 @@
 //! every (strategy, thread count) takes its turn.
 
 use super::least;
+use crate::counts::Counts;
 use crate::integrator::Strategy;
 use crate::render::{render, RenderSettings};
 use crate::sampler::{SamplerKind, Sampling};
@@ -25,6 +26,15 @@ pub struct Timed {
     pub slowest_samples_per_s: f64,
     /// Samples per second of every repetition, in order.
     pub runs: Vec<f64>,
+    /// What one render did (the same in every repetition).
+    pub counts: Counts,
+}
+
+impl Timed {
+    /// Rays traced per camera sample (camera, shadow and BSDF rays past the bounds test).
+    pub fn rays_per_sample(&self) -> f64 {
+        self.counts.rays() as f64 / self.counts.camera_rays.max(1) as f64
+    }
 }
 
 /// Samples per second of each strategy at each thread count, best of `repeat`. Every
@@ -47,8 +57,14 @@ pub fn throughputs(
     })
 }
 
-/// One timed render at seed 1: (seconds, busy worker seconds).
-fn timed(scene: &Scene, strategy: Strategy, kind: SamplerKind, spp: u32, t: usize) -> (f64, f64) {
+/// One timed render at seed 1: (seconds, busy worker seconds, what it did).
+fn timed(
+    scene: &Scene,
+    strategy: Strategy,
+    kind: SamplerKind,
+    spp: u32,
+    t: usize,
+) -> (f64, f64, Counts) {
     let settings = RenderSettings {
         spp,
         seed: 1,
@@ -61,7 +77,7 @@ fn timed(scene: &Scene, strategy: Strategy, kind: SamplerKind, spp: u32, t: usiz
         },
     };
     let out = render(scene, strategy, &settings);
-    (out.seconds, out.busy_seconds)
+    (out.seconds, out.busy_seconds, out.counts)
 }
 
 /// Render throughput of `scene` with one strategy and each sampler, timed in turns as
@@ -83,20 +99,20 @@ pub fn sampler_throughputs(
 
 /// `throughputs`' schedule and bookkeeping around `time`, which renders `samples` camera
 /// samples with one configuration (a strategy, a sampler) and a thread count and returns
-/// (seconds, busy worker seconds).
+/// (seconds, busy worker seconds, what it did).
 fn best_of_turns<T: Copy>(
     strategies: &[T],
     threads: &[usize],
     repeat: u32,
     samples: f64,
-    mut time: impl FnMut(T, usize) -> (f64, f64),
+    mut time: impl FnMut(T, usize) -> (f64, f64, Counts),
 ) -> Vec<Vec<Timed>> {
     let mut best: Vec<Vec<Option<Timed>>> = vec![vec![None; threads.len()]; strategies.len()];
     let mut runs = vec![vec![Vec::new(); threads.len()]; strategies.len()];
     for _ in 0..repeat.max(1) {
         for ((&strategy, best), runs) in strategies.iter().zip(&mut best).zip(&mut runs) {
             for ((b, runs), &t) in best.iter_mut().zip(runs.iter_mut()).zip(threads) {
-                let (seconds, busy_seconds) = time(strategy, t);
+                let (seconds, busy_seconds, counts) = time(strategy, t);
                 let samples_per_s = samples / seconds;
                 runs.push(samples_per_s);
                 if b.as_ref().is_none_or(|b| samples_per_s > b.samples_per_s) {
@@ -106,6 +122,7 @@ fn best_of_turns<T: Copy>(
                         work_per_sample: busy_seconds / samples,
                         slowest_samples_per_s: samples_per_s,
                         runs: Vec::new(),
+                        counts,
                     });
                 }
             }
@@ -154,7 +171,7 @@ mod tests {
                 .position(|x| x.label() == s.label())
                 .unwrap();
             let seconds = spell / ((k + 1) as f64 * t as f64);
-            (seconds, seconds * t as f64 * 0.5)
+            (seconds, seconds * t as f64 * 0.5, Counts::default())
         });
         let turn: Vec<_> = strategies
             .iter()

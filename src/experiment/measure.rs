@@ -134,6 +134,7 @@ pub(crate) fn measure(
             .chosen()
             .any(|d| d.tone_mapped)
             .then_some(extra.exposure),
+        ..Default::default()
     };
     let inputs = Inputs {
         img: &out.mean,
@@ -145,5 +146,6 @@ pub(crate) fn measure(
     for d in extra.chosen() {
         (d.set)(&mut row, (d.compute)(&inputs));
     }
+    row.set_counts(&out.counts, 1.0);
     row
 }

@@ -2,6 +2,7 @@
 //! sweep resumes where it stopped. Rows carry a `context` hash (reference key + epsilon): rows
 //! made against another scene, reference or epsilon are dropped on load, never mixed in.
 
+use crate::counts::Counts;
 use crate::output::write_atomic;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -11,7 +12,7 @@ use std::path::Path;
 pub const SWEEP: &str = "spp";
 pub const EQUAL_TIME: &str = "time";
 
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct Row {
     pub context: String,
     /// The `[[case]]` the row belongs to ("" for a file with one `scene`).
@@ -86,6 +87,29 @@ pub struct Row {
     pub flip: Option<f64>,
     #[serde(default)]
     pub exposure: Option<f64>,
+    /// What the run did, per technique (`counts::Counts`, machine-independent): camera rays,
+    /// light samples, shadow rays, BSDF samples, BSDF rays traced and ended at the
+    /// light-bounds test, BSDF and light-density evaluations, emitters weighed by the
+    /// emitter choice. Probe rows: the stream's counts scaled to the row's samples. Empty in
+    /// rows written before they were recorded.
+    #[serde(default)]
+    pub camera_rays: Option<f64>,
+    #[serde(default)]
+    pub light_samples: Option<f64>,
+    #[serde(default)]
+    pub shadow_rays: Option<f64>,
+    #[serde(default)]
+    pub bsdf_samples: Option<f64>,
+    #[serde(default)]
+    pub bsdf_rays: Option<f64>,
+    #[serde(default)]
+    pub bsdf_rejected: Option<f64>,
+    #[serde(default)]
+    pub bsdf_evals: Option<f64>,
+    #[serde(default)]
+    pub light_pdf_evals: Option<f64>,
+    #[serde(default)]
+    pub choice_evals: Option<f64>,
 }
 
 impl Row {
@@ -99,6 +123,40 @@ impl Row {
 
     pub fn is_sweep(&self) -> bool {
         self.kind == SWEEP
+    }
+
+    /// Records `c` times `scale` (1 for a render; a probe row's share of its stream).
+    pub fn set_counts(&mut self, c: &Counts, scale: f64) {
+        let [a, b, d, e, f, g, h, i, j] = c.values().map(|v| Some(v as f64 * scale));
+        (self.camera_rays, self.light_samples, self.shadow_rays) = (a, b, d);
+        (self.bsdf_samples, self.bsdf_rays, self.bsdf_rejected) = (e, f, g);
+        (self.bsdf_evals, self.light_pdf_evals, self.choice_evals) = (h, i, j);
+    }
+
+    /// The counts recorded, if the row has them.
+    pub fn counts(&self) -> Option<[f64; 9]> {
+        let v = [
+            self.camera_rays,
+            self.light_samples,
+            self.shadow_rays,
+            self.bsdf_samples,
+            self.bsdf_rays,
+            self.bsdf_rejected,
+            self.bsdf_evals,
+            self.light_pdf_evals,
+            self.choice_evals,
+        ];
+        v.iter()
+            .all(Option::is_some)
+            .then(|| v.map(|x| x.unwrap_or(0.0)))
+    }
+
+    /// Rays traced per sample (camera, shadow and BSDF rays past the bounds test), if the
+    /// row has its counts.
+    pub fn rays_per_sample(&self) -> Option<f64> {
+        let samples = self.width as f64 * self.height as f64 * self.spp as f64;
+        let rays = self.camera_rays? + self.shadow_rays? + self.bsdf_rays?;
+        (samples > 0.0).then(|| rays / samples)
     }
 }
 
@@ -208,6 +266,7 @@ pub(crate) fn test_row(strategy: &str, spp: u32, seed: u64) -> Row {
         ssim_error: None,
         flip: None,
         exposure: None,
+        ..Default::default()
     }
 }
 

@@ -52,6 +52,7 @@
 pub mod bsdf;
 pub mod build_key;
 pub mod camera;
+pub mod counts;
 pub mod emitter;
 pub mod film;
 pub mod fnv;

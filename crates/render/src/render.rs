@@ -1,6 +1,7 @@
 //! The render loop: tiles in parallel, every camera sample seeded from (seed, pixel, sample)
 //! so the image is bitwise identical for any thread count.
 
+use crate::counts::Counts;
 use crate::film::Image;
 use crate::integrator::{LaneKernel, LaneScratch, Strategy};
 use crate::rng::LANES;
@@ -93,6 +94,9 @@ pub struct RenderOutput {
     pub busy_seconds: f64,
     /// Samples that were NaN or infinite (counted as 0 in the mean).
     pub non_finite_samples: u64,
+    /// What the render did, per technique (rays, evaluations): the same for any thread
+    /// count, shard or machine.
+    pub counts: Counts,
 }
 
 impl RenderOutput {
@@ -192,8 +196,8 @@ impl PixelStats {
     }
 }
 
-/// A tile's pixels and the seconds its worker spent on them.
-type TileResult = (Vec<(u32, u32, PixelResult)>, f64);
+/// A tile's pixels, the seconds its worker spent on them and what it did.
+type TileResult = (Vec<(u32, u32, PixelResult)>, f64, Counts);
 
 struct PixelResult {
     mean: [f64; 3],
@@ -350,7 +354,7 @@ pub(crate) fn render_with(kernel: &LaneKernel, settings: &RenderSettings) -> Ren
                         total,
                     );
                 }
-                (out, tile_start.elapsed().as_secs_f64())
+                (out, tile_start.elapsed().as_secs_f64(), scratch.counts)
             })
             .collect()
     });
@@ -359,6 +363,7 @@ pub(crate) fn render_with(kernel: &LaneKernel, settings: &RenderSettings) -> Ren
     let mut variance = Image::new(w, h);
     let mut non_finite_samples = 0;
     let busy_seconds = results.iter().map(|r| r.1).sum();
+    let counts = results.iter().map(|r| r.2).sum();
     for (x, y, r) in results.into_iter().flat_map(|r| r.0) {
         mean.set(x, y, r.mean);
         variance.set(x, y, r.var_of_mean);
@@ -371,6 +376,7 @@ pub(crate) fn render_with(kernel: &LaneKernel, settings: &RenderSettings) -> Ren
         seconds,
         busy_seconds,
         non_finite_samples,
+        counts,
     }
 }
 

@@ -2,6 +2,7 @@
 //! path the lanes take, and random scenes (`scene::random`) for what no one thought to fix.
 
 use super::*;
+use crate::counts::Counts;
 use crate::emitter::EmitterSelection;
 use crate::named::Named;
 use crate::rng::Rng;
@@ -20,23 +21,26 @@ struct PerSample<'a> {
 }
 
 impl LanesVisitor for PerSample<'_> {
-    type Output = Vec<Vec3>;
-    fn visit<L: SamplerLanes>(self) -> Vec<Vec3> {
+    type Output = (Vec<Vec3>, Counts);
+    fn visit<L: SamplerLanes>(self) -> (Vec<Vec3>, Counts) {
         let pixel = L::pixel(&self.cfg, self.x, self.y);
-        (0..self.spp)
+        let mut c = Counts::default();
+        let li = (0..self.spp)
             .map(|s| {
                 let mut one = L::start(pixel, s as u64).lane(0);
                 let ray = self.scene.camera.generate_ray(self.x, self.y, &mut one);
-                self.direct.li(&ray, &mut one)
+                self.direct.li_counted(&ray, &mut one, &mut c)
             })
-            .collect()
+            .collect();
+        (li, c)
     }
 }
 
 /// Renders with `kernel` and recomputes every pixel from its definition: the sampler's
 /// sample (for `independent`, generator `for_sample(seed, pixel, s)`), `generate_ray`, `li`,
 /// one sample at a time. The first pixel whose mean or variance differs in any bit is the
-/// error; otherwise the count of lit pixels.
+/// error, or counts (`Counts`) that differ from the per-sample ones; otherwise the count of
+/// lit pixels.
 fn per_sample_mismatch(kernel: &LaneKernel, settings: &RenderSettings) -> Result<u32, String> {
     let out = render_with(kernel, settings);
     let (scene, strategy) = (kernel.direct.scene, kernel.direct.strategy);
@@ -44,10 +48,11 @@ fn per_sample_mismatch(kernel: &LaneKernel, settings: &RenderSettings) -> Result
     let cam = &scene.camera;
     let cfg = settings.sampler_config((cam.width, cam.height))?;
     let mut lit = 0;
+    let mut counts = Counts::default();
     for y in 0..cam.height {
         for x in 0..cam.width {
             let mut st = PixelStats::default();
-            let li = settings.sampling.kind.visit(PerSample {
+            let (li, c) = settings.sampling.kind.visit(PerSample {
                 scene,
                 direct: &direct,
                 cfg,
@@ -55,6 +60,7 @@ fn per_sample_mismatch(kernel: &LaneKernel, settings: &RenderSettings) -> Result
                 y,
                 spp: settings.spp,
             });
+            counts += c;
             for batch in li.chunks(LANES) {
                 let v = std::array::from_fn(|i| batch.get(i).copied().unwrap_or_default());
                 st.push_batch(&v, batch.len());
@@ -71,6 +77,12 @@ fn per_sample_mismatch(kernel: &LaneKernel, settings: &RenderSettings) -> Result
                 ));
             }
         }
+    }
+    if out.counts != counts {
+        return Err(format!(
+            "render counts {:?}, per sample {counts:?}",
+            out.counts
+        ));
     }
     Ok(lit)
 }

@@ -77,6 +77,7 @@ pub(crate) fn rows(
                 ssim_error: None,
                 flip: None,
                 exposure: None,
+                ..Default::default()
             }
         })
         .collect()

@@ -86,6 +86,12 @@ macro_rules! rules {
                     $(Rule::$variant(r) => <$ty as ChoiceRule>::tree_stats(r),)*
                 }
             }
+
+            fn evaluations(&self, count: usize) -> u64 {
+                match self {
+                    $(Rule::$variant(r) => <$ty as ChoiceRule>::evaluations(r, count),)*
+                }
+            }
         }
 
         impl EmitterSelection {
@@ -211,14 +217,23 @@ impl TryFrom<String> for EmitterSelection {
 pub struct EmitterSelector {
     rule: Rule,
     count: usize,
+    evaluations: u64,
 }
 
 impl EmitterSelector {
     /// The rule `mode` over `emitters`, with `shapes` for the lights' bounds.
     pub fn new(emitters: &[Emitter], shapes: &[Shape], mode: EmitterSelection) -> Self {
+        let rule = Rule::build(mode, emitters, shapes);
+        let count = emitters.len();
+        let evaluations = if count == 0 {
+            0
+        } else {
+            rule.evaluations(count)
+        };
         EmitterSelector {
-            rule: Rule::build(mode, emitters, shapes),
-            count: emitters.len(),
+            rule,
+            count,
+            evaluations,
         }
     }
 
@@ -257,6 +272,12 @@ impl EmitterSelector {
         (0..emitters.len())
             .filter(|&i| super::LightBounds::of(&emitters[i], shapes).is_none())
             .collect()
+    }
+
+    /// Emitters (or tree nodes) weighed per `sample` or `pmf` (see `counts::Counts`).
+    #[inline(always)]
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations
     }
 
     /// The light tree's depth and size in bytes, if this is the tree (the bench).

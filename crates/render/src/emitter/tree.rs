@@ -330,4 +330,11 @@ impl ChoiceRule for LightTree {
     fn tree_stats(&self) -> Option<(usize, usize)> {
         Some((self.depth(), self.bytes()))
     }
+
+    /// The two children of each inner node on a root-to-leaf path, counted at the tree's
+    /// depth (paths are shorter in an unbalanced tree: an upper bound, the same for every
+    /// draw); a tree of one leaf weighs that leaf.
+    fn evaluations(&self, _count: usize) -> u64 {
+        (2 * (self.depth() as u64).saturating_sub(1)).max(1)
+    }
 }

@@ -8,6 +8,7 @@
 
 use super::Strategy;
 use crate::bsdf::{BsdfSample, Material};
+use crate::counts::Counts;
 use crate::emitter::{EmitterSelector, LightSample};
 use crate::geometry::{Hit, Ray, SurfacePoint};
 use crate::math::{luminance, Frame, Rgb};
@@ -215,17 +216,30 @@ impl<'a> Direct<'a> {
     /// technique's selection probability; a delta light is asked with p_bsdf = 0, since no
     /// other technique can produce it.
     #[inline]
-    pub(super) fn light_sample(&self, sh: &Shading, rng: &mut impl Sampler, weight: Weight) -> Rgb {
-        let drawn = self.light_draw(sh, rng);
-        self.light_finish(sh, drawn, weight)
+    pub(super) fn light_sample(
+        &self,
+        sh: &Shading,
+        rng: &mut impl Sampler,
+        weight: Weight,
+        c: &mut Counts,
+    ) -> Rgb {
+        let drawn = self.light_draw(sh, rng, c);
+        self.light_finish(sh, drawn, weight, c)
     }
 
     /// The random half of a light sample: the emitter, its point and density.
     #[inline(always)]
-    pub(super) fn light_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<LightDraw> {
+    pub(super) fn light_draw(
+        &self,
+        sh: &Shading,
+        rng: &mut impl Sampler,
+        c: &mut Counts,
+    ) -> Option<LightDraw> {
         if let Some(m) = self.ris {
-            return self.ris_draw(sh, rng, m).map(|(d, _)| d);
+            return self.ris_draw(sh, rng, m, c).map(|(d, _)| d);
         }
+        c.light_samples += 1;
+        c.choice_evals += self.selector.evaluations();
         let (ls, pmf) = self.candidate(&sh.sp, rng.light())?;
         Some(LightDraw {
             ls,
@@ -262,6 +276,7 @@ impl<'a> Direct<'a> {
         sh: &Shading,
         rng: &mut impl Sampler,
         m: u32,
+        c: &mut Counts,
     ) -> Option<(LightDraw, LightDims)> {
         const BELOW_ONE: f64 = 1.0 - f64::EPSILON / 2.0;
         let mut u = rng.technique() as f64;
@@ -269,9 +284,12 @@ impl<'a> Direct<'a> {
         let mut kept: Option<(LightSample, f32, f32, LightDims)> = None;
         for _ in 0..m {
             let dims = rng.light();
+            c.light_samples += 1;
+            c.choice_evals += self.selector.evaluations();
             let Some((ls, pmf)) = self.candidate(&sh.sp, dims) else {
                 continue;
             };
+            c.bsdf_evals += 1;
             let (f, _) = sh.mat.eval_pdf(sh.wi, sh.frame.to_local(ls.wi));
             let p_hat = luminance(f * ls.li);
             let w = p_hat as f64 / (pmf as f64 * ls.pdf as f64);
@@ -305,10 +323,11 @@ impl<'a> Direct<'a> {
         sp: &SurfacePoint,
         d: Vec3,
         rng: &mut impl Sampler,
+        c: &mut Counts,
     ) -> Option<(LightDims, f32)> {
         let m = self.ris.expect("RIS over several candidates");
         let sh = self.shading(sp, d);
-        self.ris_draw(&sh, rng, m)
+        self.ris_draw(&sh, rng, m, c)
             .map(|(drawn, dims)| (dims, drawn.p_div))
     }
 
@@ -319,15 +338,18 @@ impl<'a> Direct<'a> {
         sh: &Shading,
         drawn: Option<LightDraw>,
         weight: Weight,
+        c: &mut Counts,
     ) -> Rgb {
         let Some(LightDraw { ls, pmf, p_div }) = drawn else {
             return Rgb::ZERO;
         };
         let wo = sh.frame.to_local(ls.wi);
+        c.bsdf_evals += 1;
         let (f, pdf) = sh.mat.eval_pdf(sh.wi, wo);
         if f == Rgb::ZERO || ls.li == Rgb::ZERO {
             return Rgb::ZERO;
         }
+        c.shadow_rays += 1;
         if !self.scene.visible(&sh.sp, &ls) {
             return Rgb::ZERO;
         }
@@ -340,14 +362,26 @@ impl<'a> Direct<'a> {
     /// One BSDF-technique sample: follow the sampled direction and collect emission there.
     /// Delta lobes are asked for their weight with p_light = 0 (light sampling cannot hit them).
     #[inline]
-    pub(super) fn bsdf_sample(&self, sh: &Shading, rng: &mut impl Sampler, weight: Weight) -> Rgb {
-        let drawn = self.bsdf_draw(sh, rng);
-        self.bsdf_finish(sh, drawn, weight)
+    pub(super) fn bsdf_sample(
+        &self,
+        sh: &Shading,
+        rng: &mut impl Sampler,
+        weight: Weight,
+        c: &mut Counts,
+    ) -> Rgb {
+        let drawn = self.bsdf_draw(sh, rng, c);
+        self.bsdf_finish(sh, drawn, weight, c)
     }
 
     /// The random half of a BSDF sample.
     #[inline(always)]
-    pub(super) fn bsdf_draw(&self, sh: &Shading, rng: &mut impl Sampler) -> Option<BsdfSample> {
+    pub(super) fn bsdf_draw(
+        &self,
+        sh: &Shading,
+        rng: &mut impl Sampler,
+        c: &mut Counts,
+    ) -> Option<BsdfSample> {
+        c.bsdf_samples += 1;
         let u = rng.bsdf();
         sh.mat.sample(sh.wi, u.lobe, u.direction)
     }
@@ -359,6 +393,7 @@ impl<'a> Direct<'a> {
         sh: &Shading,
         drawn: Option<BsdfSample>,
         weight: Weight,
+        c: &mut Counts,
     ) -> Rgb {
         let scene = self.scene;
         let Some(bs) = drawn else {
@@ -366,7 +401,7 @@ impl<'a> Direct<'a> {
         };
         let d = sh.frame.to_world(bs.wo);
         let (ray, emitter_skip) = scene.bsdf_ray(&sh.sp, d);
-        self.bsdf_arrive(&sh.sp, &ray, emitter_skip, &bs, weight)
+        self.bsdf_arrive(&sh.sp, &ray, emitter_skip, &bs, weight, c)
     }
 
     /// A BSDF sample's ray from `from` traced: the emission it reaches, weighted.
@@ -378,9 +413,16 @@ impl<'a> Direct<'a> {
         emitter_skip: u32,
         bs: &BsdfSample,
         weight: Weight,
+        c: &mut Counts,
     ) -> Rgb {
-        match self.scene.bsdf_ray_hit(ray, emitter_skip) {
-            Some(hit) => self.bsdf_emission(from, ray.d, &hit, bs, weight),
+        let scene = self.scene;
+        if !scene.bsdf_ray_may_hit(ray) {
+            c.bsdf_rejected += 1;
+            return Rgb::ZERO;
+        }
+        c.bsdf_rays += 1;
+        match scene.bsdf_ray_hit_traced(ray, emitter_skip) {
+            Some(hit) => self.bsdf_emission(from, ray.d, &hit, bs, weight, c),
             None => Rgb::ZERO,
         }
     }
@@ -394,6 +436,7 @@ impl<'a> Direct<'a> {
         hit: &Hit,
         bs: &BsdfSample,
         weight: Weight,
+        c: &mut Counts,
     ) -> Rgb {
         let scene = self.scene;
         let Some((ei, e)) = scene.emitter_at(&hit.sp) else {
@@ -406,6 +449,8 @@ impl<'a> Direct<'a> {
         let p_light = if bs.delta {
             0.0
         } else {
+            c.light_pdf_evals += 1;
+            c.choice_evals += self.selector.evaluations();
             self.selector.pmf(from.p, from.ns, ei)
                 * e.pdf(&scene.shapes, from.p, &hit.sp, self.strategy.light_sampling)
         };

@@ -301,11 +301,17 @@ impl Scene {
     /// monotone in tmax.)
     #[inline(always)]
     pub fn bsdf_ray_hit(&self, ray: &Ray, emitter_skip: u32) -> Option<Hit> {
-        match &self.emitter_accel {
-            // Inline, the scalar reject that most BSDF rays end at.
-            Some(e) if !e.may_hit(ray) => None,
-            _ => self.bsdf_ray_hit_traced(ray, emitter_skip),
+        match self.bsdf_ray_may_hit(ray) {
+            false => None,
+            true => self.bsdf_ray_hit_traced(ray, emitter_skip),
         }
+    }
+
+    /// `bsdf_ray_hit`'s reject, inline: false for a ray that reaches no light's bounds (most
+    /// BSDF rays end here), whose answer is then None.
+    #[inline(always)]
+    pub fn bsdf_ray_may_hit(&self, ray: &Ray) -> bool {
+        self.emitter_accel.as_ref().is_none_or(|e| e.may_hit(ray))
     }
 
     /// `bsdf_ray_hit`'s reject (`Accel::may_hit`) of each ray set in `active`, in lanes: the

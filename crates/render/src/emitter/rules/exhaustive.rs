@@ -73,4 +73,9 @@ impl ChoiceRule for Exhaustive {
     fn none_probability(&self, p: Vec3, n: Vec3) -> f64 {
         (total(&self.0, p, n) == 0.0) as u8 as f64
     }
+
+    /// Every emitter's weight, to normalise.
+    fn evaluations(&self, count: usize) -> u64 {
+        count as u64
+    }
 }

@@ -37,4 +37,9 @@ pub trait ChoiceRule: Clone + std::fmt::Debug + Sized {
     fn tree_stats(&self) -> Option<(usize, usize)> {
         None
     }
+    /// Emitters (or nodes) it weighs in one draw or one pmf among `count` emitters, the
+    /// emitter-choice count of `counts::Counts`: one table lookup by default.
+    fn evaluations(&self, _count: usize) -> u64 {
+        1
+    }
 }

@@ -38,6 +38,9 @@ pub(super) struct LightDraws {
     area: [f32; LANES],
     pub(super) pmf: [f32; LANES],
     has_normals: [bool; LANES],
+    /// The lanes whose point-dependent emitter choice chose nothing (`Direct::candidate`'s
+    /// None: no light sample, counted as none).
+    pub(super) unchosen: u32,
     /// RIS's density of each lane's kept candidate (`ris_numbers`), which the light estimate
     /// divides by instead of pmf * pdf; written and read only under RIS.
     pub(super) p_div: [f32; LANES],
@@ -154,7 +157,7 @@ impl LightDraws {
         spheres: &mut SphereDraws,
     ) {
         // The one field a lane's triangle leaves unwritten (a mesh without vertex normals).
-        d.has_normals = [false; LANES];
+        (d.has_normals, d.unchosen) = ([false; LANES], 0);
         if let Some(pmf) = selector.single() {
             // Every lane draws the one emitter: its data is copied once.
             let light = &lights[0];
@@ -191,6 +194,7 @@ impl LightDraws {
                 // No emitter chosen (`li` adds nothing): zero radiance leaves the lane's
                 // light sample out, whatever an earlier draw left in the other fields.
                 d.radiance.set(i, Rgb::ZERO);
+                d.unchosen |= 1 << i;
                 continue;
             };
             let light = &lights[e];

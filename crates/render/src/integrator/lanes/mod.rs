@@ -48,6 +48,7 @@ use super::direct::Direct;
 use super::strategies::First;
 use super::Strategy;
 use crate::bsdf::{Bsdf, BsdfKind, BsdfVisitor, Diffuse, Registered};
+use crate::counts::Counts;
 use crate::geometry::ray_packet::bits;
 use crate::geometry::{Accel, PacketHits, RayPacket};
 use crate::math::{Rgb, V3x8};
@@ -117,6 +118,9 @@ pub struct LaneScratch {
     hits: CameraHits,
     draws: LightDraws,
     shaded: Shaded,
+    /// What the batches shaded with this scratch did, camera rays included
+    /// (`counts::Counts`): the render sums its workers'.
+    pub counts: Counts,
 }
 
 /// Which paths the lanes took, counted for the tests (whose coverage lists need to know that
@@ -223,7 +227,9 @@ impl<'a> LaneKernel<'a> {
             hits,
             draws,
             shaded,
+            counts,
         } = scratch;
+        counts.camera_rays += n as u64;
         let mut out = [Rgb::ZERO; LANES];
         // The numbers of the estimator's first call, drawn from a copy that lanes left to
         // `li_hit` do not see.
@@ -231,7 +237,7 @@ impl<'a> LaneKernel<'a> {
         let pre = Pre::draw(self.first, rng);
         let scene = direct.scene;
         scene.intersect8_into(rays, (1 << n) - 1, &mut hits.camera);
-        self.camera_hits(&tables.shapes, rays, &at_hit, &mut out, hits);
+        self.camera_hits(&tables.shapes, rays, &at_hit, &mut out, hits, counts);
         if hits.covered == 0 {
             return out;
         }
@@ -247,6 +253,7 @@ impl<'a> LaneKernel<'a> {
                     pre,
                     draws,
                     o: shaded,
+                    c: counts,
                 }
             };
         }
@@ -279,6 +286,7 @@ impl<'a> LaneKernel<'a> {
         rng: &L,
         out: &mut [Rgb; LANES],
         h: &mut CameraHits,
+        c: &mut Counts,
     ) {
         let direct = &self.direct;
         // What the paths below write for some lanes only, or not at all.
@@ -304,7 +312,7 @@ impl<'a> LaneKernel<'a> {
             if !covered {
                 #[cfg(test)]
                 self.paths.note(Path::ScalarLane, 1);
-                out[i] = direct.li_hit(&rays.ray(i), &camera.point(i), &mut rng.lane(i));
+                out[i] = direct.li_hit(&rays.ray(i), &camera.point(i), &mut rng.lane(i), c);
                 continue;
             }
             h.material[i] = shape.material.map_or(0, |m| m.index);
@@ -381,10 +389,11 @@ impl<L: SamplerLanes, const SPHERES: bool> BsdfVisitor for Batch<'_, '_, '_, L, 
             pre,
             draws,
             o,
+            c,
             ..
         } = self.x;
         kernel.shade_batch_out_of_line::<B, L, SPHERES>(
-            tables, h, rng, at_hit, pre, draws, o, self.out,
+            tables, h, rng, at_hit, pre, draws, o, c, self.out,
         )
     }
 }

@@ -13,6 +13,7 @@ use super::tables::LaneTables;
 use super::Path;
 use super::{CameraHits, LaneKernel, LightDraws, Shaded};
 use crate::bsdf::{Bsdf, Registered};
+use crate::counts::Counts;
 use crate::geometry::ray_packet::bits;
 use crate::integrator::direct::Weight;
 use crate::integrator::strategies::{self, First, Techniques};
@@ -52,6 +53,7 @@ pub(super) struct Lanes<'k, 'a, L: SamplerLanes, const SPHERES: bool> {
     pub(super) pre: Pre,
     pub(super) draws: &'k mut LightDraws,
     pub(super) o: &'k mut Shaded,
+    pub(super) c: &'k mut Counts,
 }
 
 impl<'k, 'a, L: SamplerLanes, const SPHERES: bool> Lanes<'k, 'a, L, SPHERES> {
@@ -115,7 +117,7 @@ impl<B: Bsdf, L: SamplerLanes, const SPHERES: bool, const U: bool>
         let direct = &x.kernel.direct;
         if direct.ris.is_some() {
             let mut u = [[0.0; LANES]; 4];
-            ris_numbers(direct, x.rng, h, live, &mut u, &mut x.draws.p_div);
+            ris_numbers(direct, x.rng, h, live, &mut u, &mut x.draws.p_div, x.c);
             return u;
         }
         masked(x.rng, live, h.covered, |r| r.light())
@@ -196,8 +198,9 @@ impl<B: Bsdf, L: SamplerLanes, const SPHERES: bool, const U: bool> Techniques
         };
         let x = &mut self.lanes;
         let (k, h, s) = (x.kernel, x.h, &self.setup);
-        let lit =
-            light_step::<B, SPHERES, U>(k, x.tables, self.b, h, s, &u, x.draws, x.o, live, weight);
+        let lit = light_step::<B, SPHERES, U>(
+            k, x.tables, self.b, h, s, &u, x.draws, x.o, x.c, live, weight,
+        );
         add(&mut self.l, &x.o.light, lit, live, n);
     }
 
@@ -213,7 +216,7 @@ impl<B: Bsdf, L: SamplerLanes, const SPHERES: bool, const U: bool> Techniques
         };
         let x = &mut self.lanes;
         let (k, h, s) = (x.kernel, x.h, &self.setup);
-        let bsdf = bsdf_step::<B, SPHERES, U>(k, self.b, h, s, &u, x.o, live, weight);
+        let bsdf = bsdf_step::<B, SPHERES, U>(k, self.b, h, s, &u, x.o, x.c, live, weight);
         add(&mut self.l, &bsdf, !0, live, n);
     }
 
@@ -242,6 +245,7 @@ impl<B: Bsdf, L: SamplerLanes, const SPHERES: bool, const U: bool> Techniques
             &ub,
             x.draws,
             x.o,
+            x.c,
             light_weight,
             bsdf_weight,
         );
@@ -319,9 +323,12 @@ impl LaneKernel<'_> {
                     pre,
                     draws,
                     o,
+                    c,
                     ..
                 } = x;
-                self.shade_mixed::<B, L, SPHERES>(tables, h, rng, at_hit, pre, draws, o, first, out)
+                self.shade_mixed::<B, L, SPHERES>(
+                    tables, h, rng, at_hit, pre, draws, o, c, first, out,
+                )
             }
         }
     }
@@ -344,6 +351,7 @@ impl LaneKernel<'_> {
         pre: Pre,
         draws: &mut LightDraws,
         o: &mut Shaded,
+        c: &mut Counts,
         out: &mut [Rgb; LANES],
     ) {
         let x = Lanes::<L, SPHERES> {
@@ -355,6 +363,7 @@ impl LaneKernel<'_> {
             pre,
             draws,
             o,
+            c,
         };
         self.shade_batch::<B, L, SPHERES>(x, out)
     }
@@ -373,6 +382,7 @@ impl LaneKernel<'_> {
         pre: Pre,
         draws: &mut LightDraws,
         o: &mut Shaded,
+        c: &mut Counts,
         first: B,
         out: &mut [Rgb; LANES],
     ) {
@@ -385,6 +395,7 @@ impl LaneKernel<'_> {
             pre,
             draws,
             o,
+            c,
         };
         let materials = &self.direct.scene.materials;
         // Each lane's BSDF; the first material's for lanes not covered.

@@ -13,6 +13,7 @@ use super::tables::LaneTables;
 use super::Path;
 use super::{mask_of, CameraHits, LaneKernel, LightDraws, Shaded, SphereDraws};
 use crate::bsdf::{Bsdf, BsdfSample, Material};
+use crate::counts::Counts;
 use crate::geometry::ray_packet::bits;
 use crate::integrator::direct::{by_weight, Weight};
 use crate::integrator::Direct;
@@ -71,13 +72,28 @@ pub(super) fn light_step<B: Bsdf, const SPHERES: bool, const U: bool>(
     u: &[[f32; LANES]; 4],
     ld: &mut LightDraws,
     o: &mut Shaded,
+    c: &mut Counts,
     live: u32,
     weight: Weight,
 ) -> u32 {
-    by_weight!(weight, |w| shade_light::<B, SPHERES, U>(
+    let drawn = by_weight!(weight, |w| shade_light::<B, SPHERES, U>(
         k, tables, b, h, s, u, ld, o, live, w
     ));
-    trace_light(k.direct.scene, h, o, live)
+    count_light(k, live, drawn, c);
+    trace_light(k.direct.scene, h, o, live, c)
+}
+
+/// What `Direct::light_draw` and `light_finish` count of the light samples of `live`, the
+/// BSDF evaluated at those `drawn` (RIS counts its candidates as it draws them).
+#[inline(always)]
+fn count_light(k: &LaneKernel, live: u32, drawn: u32, c: &mut Counts) {
+    let direct = &k.direct;
+    if direct.ris.is_none() {
+        let n = live.count_ones() as u64;
+        c.light_samples += n;
+        c.choice_evals += n * direct.selector.evaluations();
+    }
+    c.bsdf_evals += drawn.count_ones() as u64;
 }
 
 /// A BSDF sample at the lanes of `live` with numbers `u`, shaded and traced: each lane's
@@ -91,11 +107,13 @@ pub(super) fn bsdf_step<B: Bsdf, const SPHERES: bool, const U: bool>(
     s: &Setup,
     u: &[[f32; LANES]; 3],
     o: &mut Shaded,
+    c: &mut Counts,
     live: u32,
     weight: Weight,
 ) -> V3x8 {
+    c.bsdf_samples += live.count_ones() as u64;
     shade_bsdf::<B, U>(b, h, s, u, o, live);
-    trace_bsdf::<SPHERES>(&k.direct, h, o, live, weight)
+    trace_bsdf::<SPHERES>(&k.direct, h, o, live, weight, c)
 }
 
 /// `light_step` and then `bsdf_step` at every covered lane, both shaded before either traces
@@ -112,18 +130,21 @@ pub(super) fn pair_step<B: Bsdf, const SPHERES: bool, const U: bool>(
     ub: &[[f32; LANES]; 3],
     ld: &mut LightDraws,
     o: &mut Shaded,
+    c: &mut Counts,
     light_weight: Weight,
     bsdf_weight: Weight,
 ) -> (u32, V3x8) {
     let live = h.covered;
-    by_weight!(light_weight, |w| shade_light::<B, SPHERES, U>(
+    let drawn = by_weight!(light_weight, |w| shade_light::<B, SPHERES, U>(
         k, tables, b, h, s, ul, ld, o, live, w
     ));
+    count_light(k, live, drawn, c);
+    c.bsdf_samples += live.count_ones() as u64;
     shade_bsdf::<B, U>(b, h, s, ub, o, live);
-    let lit = trace_light(k.direct.scene, h, o, live);
+    let lit = trace_light(k.direct.scene, h, o, live, c);
     (
         lit,
-        trace_bsdf::<SPHERES>(&k.direct, h, o, live, bsdf_weight),
+        trace_bsdf::<SPHERES>(&k.direct, h, o, live, bsdf_weight, c),
     )
 }
 
@@ -145,7 +166,8 @@ pub(super) fn setup<B: Bsdf, const U: bool>(b: &[B; LANES], h: &CameraHits) -> S
 /// the lanes of `live` with numbers `u`: each lane's term, whether it may be nonzero, and
 /// its shadow ray, in `o`. Area sampling of area lights reads the lane tables for all lanes
 /// at once (lanes outside `live` compute garbage, dropped); anything else draws each live
-/// lane's light with `Direct::candidate`.
+/// lane's light with `Direct::candidate`. Returns the lanes of `live` that drew a light
+/// sample (`Direct::light_draw`'s Some).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)] // the lanes' arrays, each its own argument (see `LaneScratch`)
 fn shade_light<B: Bsdf, const SPHERES: bool, const U: bool>(
@@ -159,9 +181,10 @@ fn shade_light<B: Bsdf, const SPHERES: bool, const U: bool>(
     o: &mut Shaded,
     live: u32,
     weight: impl Fn(f32, f32) -> f32 + Copy,
-) {
+) -> u32 {
     let direct = &k.direct;
     let ris = direct.ris.is_some();
+    let mut drawn_lanes = 0;
     #[cfg(test)]
     k.paths.note(
         match tables.area() {
@@ -188,6 +211,9 @@ fn shade_light<B: Bsdf, const SPHERES: bool, const U: bool>(
         for i in 0..LANES {
             let sp = h.camera.point(i);
             let (drawn, wi, pdf_area, li, lsp) = light_sample::<SPHERES>(sp.p, ld, sd, u, i);
+            // A RIS lane that kept no candidate drew from numbers 0: no sample (`li`).
+            let drawn = drawn && !(ris && ld.p_div[i] == f32::INFINITY);
+            drawn_lanes |= (drawn as u32) << i;
             let p_light = ld.pmf[i] * pdf_area;
             let origin = sp.spawn_origin(lsp.p - sp.p);
             let light = LaneLight {
@@ -213,7 +239,7 @@ fn shade_light<B: Bsdf, const SPHERES: bool, const U: bool>(
                 o,
             );
         }
-        return;
+        return drawn_lanes & live & !ld.unchosen;
     }
     for i in bits(live) {
         let sp = h.camera.point(i);
@@ -222,10 +248,12 @@ fn shade_light<B: Bsdf, const SPHERES: bool, const U: bool>(
             primitive: u[1][i],
             point: Vec2::new(u[2][i], u[3][i]),
         };
-        let Some((ls, pmf)) = direct.candidate(&sp, dims) else {
+        let candidate = direct.candidate(&sp, dims);
+        let Some((ls, pmf)) = candidate.filter(|_| !(ris && ld.p_div[i] == f32::INFINITY)) else {
             o.light_ok[i] = false;
             continue;
         };
+        drawn_lanes |= 1 << i;
         let (origin, target) = Scene::shadow_ends(&sp, &ls);
         let p_light = pmf * ls.pdf;
         let light = LaneLight {
@@ -249,6 +277,7 @@ fn shade_light<B: Bsdf, const SPHERES: bool, const U: bool>(
             o,
         );
     }
+    drawn_lanes
 }
 
 /// `light_finish` before its visibility test, for lane i.
@@ -278,8 +307,9 @@ pub(super) fn light_lane<B: Bsdf>(
 /// The shadow rays of the lanes of `live` with a possible term, as one packet: the mask of
 /// those that reach their light.
 #[inline(always)]
-fn trace_light(scene: &Scene, h: &CameraHits, o: &Shaded, live: u32) -> u32 {
+fn trace_light(scene: &Scene, h: &CameraHits, o: &Shaded, live: u32, c: &mut Counts) -> u32 {
     let traced = live & h.covered & mask_of(&o.light_ok);
+    c.shadow_rays += traced.count_ones() as u64;
     traced & !scene.accel.occluded8(&o.shadow, traced)
 }
 
@@ -316,12 +346,16 @@ fn trace_bsdf<const SPHERES: bool>(
     o: &Shaded,
     live: u32,
     weight: Weight,
+    c: &mut Counts,
 ) -> V3x8 {
     let scene = direct.scene;
     let rays = &o.bsdf;
     let open = live & h.covered & mask_of(&o.bsdf_ok);
     let mut out = V3x8::default();
-    for i in bits(scene.bsdf_rays_may_hit::<SPHERES>(rays, open)) {
+    let traced = scene.bsdf_rays_may_hit::<SPHERES>(rays, open);
+    c.bsdf_rays += traced.count_ones() as u64;
+    c.bsdf_rejected += (open & !traced).count_ones() as u64;
+    for i in bits(traced) {
         let ray = rays.ray(i);
         if let Some(hit) = scene.bsdf_ray_hit_traced(&ray, h.emitter_skip[i]) {
             let bs = BsdfSample {
@@ -331,7 +365,7 @@ fn trace_bsdf<const SPHERES: bool>(
                 delta: o.bsdf_delta[i],
             };
             let from = h.camera.point(i);
-            out.set(i, direct.bsdf_emission(&from, ray.d, &hit, &bs, weight));
+            out.set(i, direct.bsdf_emission(&from, ray.d, &hit, &bs, weight, c));
         }
     }
     out
@@ -351,10 +385,11 @@ pub(super) fn ris_numbers<L: SamplerLanes>(
     live: u32,
     u: &mut [[f32; LANES]; 4],
     p_div: &mut [f32; LANES],
+    c: &mut Counts,
 ) {
     for i in bits(live) {
         let mut one = rng.lane(i);
-        match direct.ris_for_lane(&h.camera.point(i), h.d.get(i), &mut one) {
+        match direct.ris_for_lane(&h.camera.point(i), h.d.get(i), &mut one, c) {
             Some((dims, p)) => {
                 [u[0][i], u[1][i], u[2][i], u[3][i]] =
                     [dims.select, dims.primitive, dims.point.x, dims.point.y];

@@ -16,6 +16,7 @@ mod techniques;
 
 use super::direct::{Direct, Weight};
 use super::Strategy;
+use crate::counts::Counts;
 use crate::geometry::{Ray, SurfacePoint};
 use crate::math::Rgb;
 use crate::named::Named;
@@ -78,14 +79,26 @@ estimators!(
 impl Direct<'_> {
     /// Radiance along a camera ray.
     pub fn li(&self, ray: &Ray, rng: &mut impl Sampler) -> Rgb {
+        self.li_counted(ray, rng, &mut Counts::default())
+    }
+
+    /// `li`, adding what it did to `c` (the camera ray included).
+    pub fn li_counted(&self, ray: &Ray, rng: &mut impl Sampler, c: &mut Counts) -> Rgb {
+        c.camera_rays += 1;
         match self.scene.intersect(ray) {
-            Some(hit) => self.li_hit(ray, &hit.sp, rng),
+            Some(hit) => self.li_hit(ray, &hit.sp, rng, c),
             None => Rgb::ZERO,
         }
     }
 
-    /// `li` given the camera ray's hit.
-    pub(super) fn li_hit(&self, ray: &Ray, sp: &SurfacePoint, rng: &mut impl Sampler) -> Rgb {
+    /// `li` given the camera ray's hit, adding what it did past the camera ray to `c`.
+    pub(super) fn li_hit(
+        &self,
+        ray: &Ray,
+        sp: &SurfacePoint,
+        rng: &mut impl Sampler,
+        c: &mut Counts,
+    ) -> Rgb {
         let scene = self.scene;
         let mut l = Rgb::ZERO;
         if !self.strategy.hide_emitters {
@@ -97,7 +110,7 @@ impl Direct<'_> {
         // A delta BSDF gives light samples zero throughput: all its light arrives via BSDF
         // samples, which then carry weight 1.
         let delta_bsdf = sh.mat.is_delta();
-        let mut one = One::new(self, &sh, rng, l);
+        let mut one = One::new(self, &sh, rng, c, l);
         li(&mut one, delta_bsdf);
         one.l
     }

@@ -5,6 +5,7 @@
 //! kernel can draw its numbers before the camera rays are traced.
 
 use super::{Direct, Strategy, Weight};
+use crate::counts::Counts;
 use crate::integrator::direct::Shading;
 use crate::math::Rgb;
 use crate::sampler::Sampler;
@@ -39,6 +40,7 @@ pub(in crate::integrator) struct One<'r, 'd, 's, S> {
     d: &'r Direct<'d>,
     sh: &'r Shading<'s>,
     rng: &'r mut S,
+    c: &'r mut Counts,
     /// The estimate so far.
     pub(in crate::integrator) l: Rgb,
 }
@@ -48,9 +50,10 @@ impl<'r, 'd, 's, S: Sampler> One<'r, 'd, 's, S> {
         d: &'r Direct<'d>,
         sh: &'r Shading<'s>,
         rng: &'r mut S,
+        c: &'r mut Counts,
         l: Rgb,
     ) -> Self {
-        One { d, sh, rng, l }
+        One { d, sh, rng, c, l }
     }
 }
 
@@ -80,24 +83,24 @@ impl<S: Sampler> Techniques for One<'_, '_, '_, S> {
     #[inline(always)]
     fn light(&mut self, m: bool, weight: Weight, n: f32) {
         if m {
-            self.l += self.d.light_sample(self.sh, self.rng, weight) / n;
+            self.l += self.d.light_sample(self.sh, self.rng, weight, self.c) / n;
         }
     }
 
     #[inline(always)]
     fn bsdf(&mut self, m: bool, weight: Weight, n: f32) {
         if m {
-            self.l += self.d.bsdf_sample(self.sh, self.rng, weight) / n;
+            self.l += self.d.bsdf_sample(self.sh, self.rng, weight, self.c) / n;
         }
     }
 
     #[inline(always)]
     fn light_and_bsdf(&mut self, light_weight: Weight, ne: f32, bsdf_weight: Weight, nb: f32) {
         let (d, sh) = (self.d, self.sh);
-        let light = d.light_draw(sh, self.rng);
-        let bsdf = d.bsdf_draw(sh, self.rng);
-        self.l += d.light_finish(sh, light, light_weight) / ne;
-        self.l += d.bsdf_finish(sh, bsdf, bsdf_weight) / nb;
+        let light = d.light_draw(sh, self.rng, self.c);
+        let bsdf = d.bsdf_draw(sh, self.rng, self.c);
+        self.l += d.light_finish(sh, light, light_weight, self.c) / ne;
+        self.l += d.bsdf_finish(sh, bsdf, bsdf_weight, self.c) / nb;
     }
 
     #[inline(always)]
