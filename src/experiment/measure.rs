@@ -146,6 +146,6 @@ pub(crate) fn measure(
     for d in extra.chosen() {
         (d.set)(&mut row, (d.compute)(&inputs));
     }
-    row.set_counts(&out.counts, 1.0);
+    row.set_counts(&out.counts);
     row
 }

@@ -90,8 +90,7 @@ pub struct Row {
     /// What the run did, per technique (`counts::Counts`, machine-independent): camera rays,
     /// light samples, shadow rays, BSDF samples, BSDF rays traced and ended at the
     /// light-bounds test, BSDF and light-density evaluations, emitters weighed by the
-    /// emitter choice. Probe rows: the stream's counts scaled to the row's samples. Empty in
-    /// rows written before they were recorded.
+    /// emitter choice. Empty in probe rows and in rows written before they were recorded.
     #[serde(default)]
     pub camera_rays: Option<f64>,
     #[serde(default)]
@@ -125,38 +124,12 @@ impl Row {
         self.kind == SWEEP
     }
 
-    /// Records `c` times `scale` (1 for a render; a probe row's share of its stream).
-    pub fn set_counts(&mut self, c: &Counts, scale: f64) {
-        let [a, b, d, e, f, g, h, i, j] = c.values().map(|v| Some(v as f64 * scale));
+    /// Records the counts `c` of the row's render.
+    pub fn set_counts(&mut self, c: &Counts) {
+        let [a, b, d, e, f, g, h, i, j] = c.values().map(|v| Some(v as f64));
         (self.camera_rays, self.light_samples, self.shadow_rays) = (a, b, d);
         (self.bsdf_samples, self.bsdf_rays, self.bsdf_rejected) = (e, f, g);
         (self.bsdf_evals, self.light_pdf_evals, self.choice_evals) = (h, i, j);
-    }
-
-    /// The counts recorded, if the row has them.
-    pub fn counts(&self) -> Option<[f64; 9]> {
-        let v = [
-            self.camera_rays,
-            self.light_samples,
-            self.shadow_rays,
-            self.bsdf_samples,
-            self.bsdf_rays,
-            self.bsdf_rejected,
-            self.bsdf_evals,
-            self.light_pdf_evals,
-            self.choice_evals,
-        ];
-        v.iter()
-            .all(Option::is_some)
-            .then(|| v.map(|x| x.unwrap_or(0.0)))
-    }
-
-    /// Rays traced per sample (camera, shadow and BSDF rays past the bounds test), if the
-    /// row has its counts.
-    pub fn rays_per_sample(&self) -> Option<f64> {
-        let samples = self.width as f64 * self.height as f64 * self.spp as f64;
-        let rays = self.camera_rays? + self.shadow_rays? + self.bsdf_rays?;
-        (samples > 0.0).then(|| rays / samples)
     }
 }
 

@@ -31,20 +31,7 @@ pub struct Counts {
 }
 
 impl Counts {
-    /// The counters' names, in `values` order (CSV columns and the cost model's terms).
-    pub const NAMES: [&'static str; 9] = [
-        "camera_rays",
-        "light_samples",
-        "shadow_rays",
-        "bsdf_samples",
-        "bsdf_rays",
-        "bsdf_rejected",
-        "bsdf_evals",
-        "light_pdf_evals",
-        "choice_evals",
-    ];
-
-    /// The counters in `NAMES` order.
+    /// The counters, in field order.
     pub fn values(&self) -> [u64; 9] {
         [
             self.camera_rays,
@@ -59,7 +46,7 @@ impl Counts {
         ]
     }
 
-    /// The counts with the values `v` in `NAMES` order.
+    /// The counts with the values `v` in field order (`values`).
     pub fn from_values(v: [u64; 9]) -> Counts {
         let [camera_rays, light_samples, shadow_rays, bsdf_samples, bsdf_rays, bsdf_rejected, bsdf_evals, light_pdf_evals, choice_evals] =
             v;

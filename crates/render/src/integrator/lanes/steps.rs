@@ -248,8 +248,9 @@ fn shade_light<B: Bsdf, const SPHERES: bool, const U: bool>(
             primitive: u[1][i],
             point: Vec2::new(u[2][i], u[3][i]),
         };
-        let candidate = direct.candidate(&sp, dims);
-        let Some((ls, pmf)) = candidate.filter(|_| !(ris && ld.p_div[i] == f32::INFINITY)) else {
+        // A RIS lane that kept no candidate has no light sample (`li`): nothing to draw.
+        let kept = !(ris && ld.p_div[i] == f32::INFINITY);
+        let Some((ls, pmf)) = kept.then(|| direct.candidate(&sp, dims)).flatten() else {
             o.light_ok[i] = false;
             continue;
         };
