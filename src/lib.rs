@@ -16,6 +16,7 @@ pub mod check;
 pub mod chi2cases;
 pub mod choices;
 pub mod cli;
+pub mod cost;
 pub mod experiment;
 pub mod integrands;
 pub mod metrics;

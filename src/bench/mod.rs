@@ -161,7 +161,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         "scene", "strategy", "threads", "M samples/s"
     );
     for path in &scenes {
-        let scene = crate::scene::open(path, &[("res".into(), a.res.to_string())])?;
+        let scene = open_at(path, a.res)?;
         let name = path.display().to_string();
         // `res` sets the size of scenes that declare it; the others keep their own.
         println!("  {name}: {}x{}", scene.camera.width, scene.camera.height);
@@ -193,6 +193,22 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
     })?;
     eprintln!("wrote {}", a.out.display());
     Ok(())
+}
+
+/// Opens a bench scene, at resolution `res` where it declares a `res` parameter (the bundled
+/// Cornell box); other scenes keep their own size, and a define they do not declare would be
+/// refused as a typo.
+fn open_at(path: &std::path::Path, res: u32) -> Result<Scene, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let declares = crate::scene::xml::declared_parameters(&text)
+        .iter()
+        .any(|p| p == "res");
+    let defines = if declares {
+        vec![("res".to_string(), res.to_string())]
+    } else {
+        Vec::new()
+    };
+    crate::scene::open(path, &defines)
 }
 
 /// The ray-tracing limit section for one scene: the same ray mix traced alone, the share of
@@ -370,4 +386,19 @@ fn peak_memory() -> Option<u64> {
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb * 1024)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bench_scenes_open_at_the_bench_resolution_only_where_declared() {
+        // The Cornell box declares `res`; the Veach scene does not and keeps its 768x512
+        // (setting `res` there was refused, which stopped `directlab bench` at its second scene).
+        let cbox = open_at(std::path::Path::new("scenes/cbox/cbox.xml"), 24).unwrap();
+        assert_eq!((cbox.camera.width, cbox.camera.height), (24, 24));
+        let veach = open_at(std::path::Path::new("scenes/veach-mis/veach-mis.xml"), 24).unwrap();
+        assert_eq!((veach.camera.width, veach.camera.height), (768, 512));
+    }
 }

@@ -389,6 +389,24 @@ pub fn parse_document(
     Ok(tree)
 }
 
+/// The parameters `xml` declares with `<default name=...>` directly under its root, in
+/// document order: what a caller may set with a define (the bench sets `res` only where a
+/// scene declares it). A document that does not parse declares none.
+pub fn declared_parameters(xml: &str) -> Vec<String> {
+    let options = roxmltree::ParsingOptions {
+        allow_dtd: true,
+        ..Default::default()
+    };
+    let Ok(doc) = roxmltree::Document::parse_with_options(xml, options) else {
+        return Vec::new();
+    };
+    doc.root_element()
+        .children()
+        .filter(|n| n.is_element() && n.tag_name().name() == "default")
+        .filter_map(|n| n.attribute("name").map(str::to_string))
+        .collect()
+}
+
 /// What every element's conversion reads.
 struct Context {
     file: Rc<Path>,
@@ -512,6 +530,14 @@ mod tests {
         assert_eq!(normalize_name("sampleCount"), "sample_count");
         assert_eq!(normalize_name("alphaU"), "alpha_u");
         assert_eq!(normalize_name("fov_axis"), "fov_axis");
+    }
+
+    #[test]
+    fn declared_parameters_lists_the_root_defaults_only() {
+        let xml = r#"<scene><default name="res" value="8"/><default name="spp" value="$res"/>
+            <shape type="sphere"><default name="inner" value="1"/></shape></scene>"#;
+        assert_eq!(declared_parameters(xml), ["res", "spp"]);
+        assert!(declared_parameters("<scene>").is_empty());
     }
 
     #[test]
