@@ -10,13 +10,16 @@
 
 use crate::counts::Counts;
 use crate::emitter::LightSampling;
+use crate::scene::desc::StrategyKind;
 use crate::stats::nnls::nnls;
 
 /// The terms of the model, in coefficient order: per render, per pixel, per counter (in
-/// `Counts::values` order), and the extra cost of a light sample and a light-density
+/// `Counts::values` order), the extra cost of a light sample and a light-density
 /// evaluation in solid angle (spherical triangles and cones cost several times an area
-/// sample: trigonometry in f64).
-pub const TERMS: [&str; 13] = [
+/// sample: trigonometry in f64), and a cost per camera sample for each estimator that is not
+/// two-sample MIS: how it runs its techniques (light or BSDF sampling alone skip the step
+/// MIS shares between them; one-sample MIS splits each group of lanes between two steps).
+pub const TERMS: [&str; 16] = [
     "render",
     "pixel",
     "camera_ray",
@@ -30,13 +33,17 @@ pub const TERMS: [&str; 13] = [
     "choice_eval",
     "solid_angle_light_sample",
     "solid_angle_light_pdf_eval",
+    "light_only_camera_sample",
+    "bsdf_only_camera_sample",
+    "one_sample_camera_sample",
 ];
 
-/// What one render did: its size, its counts and how it drew light points.
+/// What one render did: its size, its counts, its estimator and how it drew light points.
 #[derive(Clone, Copy, Debug)]
 pub struct Work {
     pub pixels: u64,
     pub counts: Counts,
+    pub kind: StrategyKind,
     pub light_sampling: LightSampling,
 }
 
@@ -45,6 +52,7 @@ impl Work {
     pub fn terms(&self) -> [f64; TERMS.len()] {
         let c = self.counts.values().map(|v| v as f64);
         let sa = f64::from(u8::from(self.light_sampling == LightSampling::SolidAngle));
+        let kind = |k| f64::from(u8::from(self.kind == k)) * c[0];
         [
             1.0,
             self.pixels as f64,
@@ -59,6 +67,9 @@ impl Work {
             c[8],
             sa * c[1],
             sa * c[7],
+            kind(StrategyKind::Light),
+            kind(StrategyKind::Bsdf),
+            kind(StrategyKind::MisOneSample),
         ]
     }
 }
@@ -116,6 +127,10 @@ mod tests {
     use super::*;
 
     fn work(spp: u64, shadow: u64, sa: bool) -> Work {
+        work_of(spp, shadow, sa, StrategyKind::Mis)
+    }
+
+    fn work_of(spp: u64, shadow: u64, sa: bool, kind: StrategyKind) -> Work {
         let pixels = 100;
         let n = pixels * spp;
         Work {
@@ -127,6 +142,7 @@ mod tests {
                 light_pdf_evals: n / 3,
                 ..Counts::default()
             },
+            kind,
             light_sampling: if sa {
                 LightSampling::SolidAngle
             } else {
@@ -142,8 +158,13 @@ mod tests {
         assert_eq!(&t[..5], &[1.0, 100.0, 400.0, 400.0, 400.0]);
         assert_eq!(t[9], 133.0);
         assert_eq!((t[11], t[12]), (400.0, 133.0));
+        assert_eq!(&t[13..], &[0.0; 3]);
         let t = work(4, 2, false).terms();
         assert_eq!((t[11], t[12]), (0.0, 0.0));
+        let t = work_of(4, 2, false, StrategyKind::MisOneSample).terms();
+        assert_eq!(&t[13..], &[0.0, 0.0, 400.0]);
+        let t = work_of(4, 2, false, StrategyKind::Light).terms();
+        assert_eq!(&t[13..], &[400.0, 0.0, 0.0]);
     }
 
     #[test]

@@ -62,6 +62,11 @@ fn bench_writes_every_section() {
         "x the independent sampler's time per sample",
         "emitter choice alone",
         "tree: depth",
+        "cost model (",
+        "held out",
+        "worst held-out prediction error",
+        "light sampling alone: ",
+        "(paired median; goal 1.2x",
     ] {
         assert!(
             stdout.contains(printed),
@@ -89,6 +94,12 @@ fn check_rows(out: &std::path::Path) {
         // anything, but it is a number.
         if row[2].contains("share_outside_traversal") || row[2].contains("outside_traversal_per") {
             assert!(value.is_finite(), "{what}: {value}");
+        } else if row[0].starts_with("cost_prediction_error") {
+            // Modelled / measured - 1: above -1 (the model predicts no negative time).
+            assert!(value.is_finite() && value >= -1.0, "{what}: {value}");
+        } else if &row[0] == "cost_model" {
+            // A cost per unit is never negative; a term the runs do not need costs 0.
+            assert!(value.is_finite() && value >= 0.0, "{what}: {value}");
         } else {
             assert!(value.is_finite() && value > 0.0, "{what}: {value}");
         }
@@ -144,6 +155,20 @@ fn check_rows(out: &std::path::Path) {
     // Reading and building the scene of 1,000 emitters.
     assert_eq!(sections["load_xml"], 1, "{sections:?}");
     assert_eq!(sections["load_build"], 1, "{sections:?}");
+    // Each goal of light, BSDF, one-sample and solid-angle against power MIS, per thread count.
+    assert_eq!(sections["throughput_ratio"], 4 * 2, "{sections:?}");
+    // The cost model: one coefficient per term, its error on the 16 runs it was fitted on
+    // (7 strategies at two spp, two MIS sample-count mixes) and the 6 it never saw.
+    assert_eq!(
+        sections["cost_model"],
+        directlab::cost::TERMS.len(),
+        "{sections:?}"
+    );
+    assert_eq!(sections["cost_prediction_error_fitted"], 16, "{sections:?}");
+    assert_eq!(
+        sections["cost_prediction_error_held_out"], 6,
+        "{sections:?}"
+    );
     // The CPU the numbers were measured on, named.
     assert_eq!(sections["machine"], 1, "{sections:?}");
     // Every sampler's speed and its slowdown against the independent one (whose own is 1).

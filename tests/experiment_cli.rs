@@ -79,6 +79,8 @@ fn quick_experiment_writes_results_plots_report_and_resumes() {
         "convergence.svg",
         "error_vs_time.png",
         "error_vs_time.svg",
+        "error_vs_cost.png",
+        "error_vs_cost.svg",
         "efficiency.png",
         "efficiency.svg",
         "equal_spp.png",
@@ -131,6 +133,20 @@ fn quick_experiment_writes_results_plots_report_and_resumes() {
     let index = std::fs::read_to_string(dir.join("index.md")).unwrap();
     assert!(index.contains("## Left out") && index.contains("noise floor"));
     assert!(index.contains("convergence.png"));
+    // Every run counted and modelled: the section, a row per strategy, the code path stated.
+    assert!(index.contains("## Counted cost") && index.contains("error_vs_cost.png"));
+    assert!(index.contains("Code path: every strategy and sampler ran in the same lane kernel"));
+    let counted = &index[index.find("## Counted cost").unwrap()..];
+    let table_rows = counted
+        .lines()
+        .skip_while(|l| !l.starts_with("|---"))
+        .skip(1)
+        .take_while(|l| l.starts_with('|'))
+        .count();
+    assert_eq!(table_rows, 2, "{counted}");
+    for col in ["camera_rays", "shadow_rays", "bsdf_evals", "choice_evals"] {
+        assert!(header.split(',').any(|c| c == col), "no column {col}");
+    }
     let root = std::fs::read_to_string(out.join("index.md")).unwrap();
     assert!(root.contains("fig2-quick/index.md"), "{root}");
     let stdout = String::from_utf8_lossy(&first.stdout);

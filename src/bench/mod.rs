@@ -3,12 +3,14 @@
 //! adds its rows: render throughput per scene, strategy and thread count with the machine's
 //! own scaling (`throughput`, `copies`), and per sampler (`samplers`); the ray-tracing limit for the same ray mix and the
 //! share of render time spent outside traversal, on one thread and on the most threads
-//! (`ray_limit_section` here, measured by `raylimit`); per-sample cost as the triangle and
+//! (`ray_limit_section` here, measured by `raylimit`); the cost model of counted work and
+//! its prediction error on renders it was not fitted on (`cost`); per-sample cost as the triangle and
 //! emitter counts grow (`sweeps`, over the scenes of `scaling`); scene loading as the emitter
 //! count grows (`load`); peak memory.
 
 mod choice;
 mod copies;
+mod cost;
 mod load;
 mod raylimit;
 mod samplers;
@@ -166,6 +168,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         // `res` sets the size of scenes that declare it; the others keep their own.
         println!("  {name}: {}x{}", scene.camera.width, scene.camera.height);
         throughput::section(&scene, &name, a, &mut rows);
+        cost::section(&scene, &name, a, &mut rows);
         samplers::section(&scene, &name, a, max_threads, &mut rows);
         ray_limit_section(&scene, &name, a, max_threads, &mut rows);
     }

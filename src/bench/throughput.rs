@@ -3,6 +3,9 @@
 
 use super::timing::{throughputs, Timed};
 use super::{bench_strategies, copies, paired_ratio, power_mis, BenchArgs, Row};
+use crate::emitter::LightSampling;
+use crate::integrator::Strategy;
+use crate::scene::desc::StrategyKind;
 use crate::scene::Scene;
 
 /// The throughput section for one scene: prints it and adds its rows.
@@ -11,6 +14,8 @@ pub(super) fn section(scene: &Scene, name: &str, a: &BenchArgs, rows: &mut Vec<R
     let mut first_speed_up = None;
     let strategies = bench_strategies();
     let timed = throughputs(scene, &strategies, a.spp, &a.threads, a.repeat);
+    let against_mis = goals_section(name, &strategies, &timed, &a.threads);
+    rows.extend(against_mis);
     for (&strategy, all) in strategies.iter().zip(timed) {
         let by_threads: Vec<(usize, Timed)> = a.threads.iter().copied().zip(all).collect();
         for &(threads, ref timed) in &by_threads {
@@ -104,4 +109,81 @@ pub(super) fn section(scene: &Scene, name: &str, a: &BenchArgs, rows: &mut Vec<R
             unit: "speed-up",
         });
     }
+}
+
+/// The speed goal of a bench strategy against power MIS with one sample of each (issue 66):
+/// light or BSDF sampling alone at least 1.2x its samples/s, one-sample MIS 1.1x, solid-angle
+/// sampling 0.7x of area sampling. None for power MIS itself and strategies without a goal.
+fn goal(s: &Strategy) -> Option<(f64, &'static str)> {
+    let mis = power_mis();
+    if *s
+        == (Strategy {
+            kind: StrategyKind::Light,
+            ..mis
+        })
+    {
+        Some((1.2, "light sampling alone"))
+    } else if *s
+        == (Strategy {
+            kind: StrategyKind::Bsdf,
+            ..mis
+        })
+    {
+        Some((1.2, "BSDF sampling alone"))
+    } else if *s
+        == (Strategy {
+            kind: StrategyKind::MisOneSample,
+            ..mis
+        })
+    {
+        Some((1.1, "one-sample MIS"))
+    } else if *s
+        == (Strategy {
+            light_sampling: LightSampling::SolidAngle,
+            ..mis
+        })
+    {
+        Some((0.7, "solid angle against area"))
+    } else {
+        None
+    }
+}
+
+/// Each strategy's samples/s over power MIS's at each thread count, paired by repetition
+/// (both timed in the same turn), printed beside its goal; the rows of `throughput_ratio`.
+fn goals_section(
+    name: &str,
+    strategies: &[Strategy],
+    timed: &[Vec<Timed>],
+    threads: &[usize],
+) -> Vec<Row> {
+    let mis = power_mis();
+    let Some(k_mis) = strategies.iter().position(|s| *s == mis) else {
+        return Vec::new();
+    };
+    let mut rows = Vec::new();
+    for (j, &t) in threads.iter().enumerate() {
+        let base = &timed[k_mis][j];
+        for (s, all) in strategies.iter().zip(timed) {
+            let Some((want, what)) = goal(s) else {
+                continue;
+            };
+            let ratio = paired_ratio(&base.runs, &all[j].runs);
+            println!(
+                "  {name}, {t} thread(s): {what}: {ratio:.2}x the samples/s of {} (paired median; goal {want:.1}x{})",
+                mis.label(),
+                if ratio >= want { ", met" } else { ", not met" },
+            );
+            rows.push(Row {
+                section: "throughput_ratio",
+                scene: name.to_string(),
+                strategy: s.label(),
+                threads: t,
+                n: 0,
+                value: ratio,
+                unit: "ratio to power MIS",
+            });
+        }
+    }
+    rows
 }

@@ -58,7 +58,7 @@ pub fn throughputs(
 }
 
 /// One timed render at seed 1: (seconds, busy worker seconds, what it did).
-fn timed(
+pub(super) fn timed(
     scene: &Scene,
     strategy: Strategy,
     kind: SamplerKind,

@@ -9,6 +9,7 @@ pub mod budget;
 pub mod cache;
 pub mod cases;
 pub mod chunks;
+pub mod costs;
 pub mod events;
 pub mod figures;
 pub mod leftout;

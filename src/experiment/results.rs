@@ -124,9 +124,35 @@ impl Row {
         self.kind == SWEEP
     }
 
+    /// The counts of the row's render; None when it has none (probe rows, older rows).
+    pub fn counts(&self) -> Option<Counts> {
+        let v = [
+            self.camera_rays,
+            self.light_samples,
+            self.shadow_rays,
+            self.bsdf_samples,
+            self.bsdf_rays,
+            self.bsdf_rejected,
+            self.bsdf_evals,
+            self.light_pdf_evals,
+            self.choice_evals,
+        ];
+        let mut out = [0u64; 9];
+        for (o, v) in out.iter_mut().zip(v) {
+            *o = v? as u64;
+        }
+        Some(Counts::from_values(out))
+    }
+
     /// Records the counts `c` of the row's render.
     pub fn set_counts(&mut self, c: &Counts) {
-        let [a, b, d, e, f, g, h, i, j] = c.values().map(|v| Some(v as f64));
+        self.set_counts_share(c, 1.0);
+    }
+
+    /// Records `share` of the counts `c` (a probe row's batch of k of a stream's n samples
+    /// did k / n of what the stream did).
+    pub fn set_counts_share(&mut self, c: &Counts, share: f64) {
+        let [a, b, d, e, f, g, h, i, j] = c.values().map(|v| Some(v as f64 * share));
         (self.camera_rays, self.light_samples, self.shadow_rays) = (a, b, d);
         (self.bsdf_samples, self.bsdf_rays, self.bsdf_rejected) = (e, f, g);
         (self.bsdf_evals, self.light_pdf_evals, self.choice_evals) = (h, i, j);

@@ -38,6 +38,8 @@ pub struct Outcome {
     pub dir: PathBuf,
     /// Kept strategies as (label, name), in the experiment's order.
     pub strategies: Vec<(String, String)>,
+    /// The method of each kept strategy, in the same order.
+    pub methods: Vec<Method>,
     pub omitted: Vec<Omission>,
     pub reference: Reference,
     pub rows: Vec<Row>,
@@ -384,6 +386,7 @@ impl Outcome {
     pub(crate) fn of(s: Setup, reference: Reference, rows: Vec<Row>, start: Instant) -> Outcome {
         Outcome {
             strategies: s.kept.iter().map(|(n, m)| (m.label(), n.clone())).collect(),
+            methods: s.kept.iter().map(|(_, m)| *m).collect(),
             omitted: s.omitted,
             rows,
             rendered: 0,

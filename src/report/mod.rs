@@ -1,6 +1,7 @@
 //! Reports: `reports/<experiment>/index.md` (and the same as `index.html`) (settings, reference and its noise,
 //! what was left out and why, tables, figures) and `reports/index.md` linking them all.
 
+mod cost;
 pub mod html;
 mod means;
 pub mod probe;
@@ -11,6 +12,7 @@ pub(crate) mod tables;
 pub use means::{mean_check, mean_check_lines, Comparison, MEAN_ALPHA};
 
 use crate::experiment::analysis::{metric_name, Series};
+use crate::experiment::costs::Costs;
 use crate::experiment::figures::Figure;
 use crate::experiment::runner::Outcome;
 use crate::output::write_atomic;
@@ -20,6 +22,13 @@ use std::path::Path;
 pub(crate) fn e(v: f64) -> String {
     format!("{v:.3e}")
 }
+
+/// How every image run of an experiment was rendered, stated in its report: one code path for
+/// all, so that time compares estimators (`render` has no other path).
+pub const LANES_NOTE: &str = "Code path: every strategy and sampler ran in the same lane kernel, \
+     eight camera samples at a time in vector lanes (a hit on an all-delta BSDF, or on another \
+     material than its batch's, is shaded lane by lane inside it); times compare estimators, \
+     and Counted cost compares their work without a clock.";
 
 fn settings(md: &mut String, o: &Outcome) {
     let x = &o.exp.exp;
@@ -49,6 +58,7 @@ fn settings(md: &mut String, o: &Outcome) {
         if o.exp.quick { " (`--quick`)" } else { "" }
     );
     let _ = writeln!(md, "- Sweep: spp {:?}, seeds 0..{}", x.spp, x.seeds);
+    let _ = writeln!(md, "- {LANES_NOTE}");
     let _ = writeln!(
         md,
         "- Error: {}; relMSE = mean((x - r)^2 / (r^2 + eps)) with eps = {}; both are corrected \
@@ -152,10 +162,14 @@ pub fn write_experiment(
     tables::rate_table(&mut md, o, series);
     tables::metrics_table(&mut md, o);
     tables::diagnostics(&mut md, o, series);
-    tables::equal_time_table(&mut md, o);
+    let costs = Costs::of(o);
+    tables::equal_time_table(&mut md, o, costs.as_ref());
     ratios::gains(&mut md, o);
     means::means(&mut md, o);
     tables::variance_table(&mut md, o);
+    if let Some(c) = &costs {
+        cost::cost_section(&mut md, &o.rows, &o.strategies, c, o.exp.equal_spp());
+    }
     let _ = writeln!(md, "## Figures\n");
     for f in figures {
         let _ = writeln!(md, "![{}]({})\n\n{}\n", f.file, f.file, f.caption);

@@ -2,7 +2,9 @@
 //! per-case, per-strategy table (non-finite samples, bias z, relMSE, largest sample,
 //! fireflies' share, slope, verdict), the accumulation check and the input checks.
 
-pub use super::probe_table::{critical, table, table_spp, TableRow, BIASED, NON_FINITE, OK, TAIL};
+pub use super::probe_table::{
+    critical, table, table_spp, PerSample, TableRow, BIASED, NON_FINITE, OK, TAIL,
+};
 use crate::experiment::analysis::metric_name;
 use crate::experiment::probe::run::ProbeOutcome;
 use std::fmt::Write as _;
@@ -137,6 +139,13 @@ fn cases(md: &mut String, o: &ProbeOutcome) {
     md.push('\n');
 }
 
+/// A counted quantity per sample, or a dash for rows without counts.
+fn counted(r: &TableRow, f: fn(&PerSample) -> f64) -> String {
+    r.per_sample
+        .as_ref()
+        .map_or("—".into(), |p| format!("{:.2}", f(p)))
+}
+
 fn results(md: &mut String, o: &ProbeOutcome, t: &[TableRow]) {
     let spp = table_spp(o);
     let _ = writeln!(
@@ -144,17 +153,22 @@ fn results(md: &mut String, o: &ProbeOutcome, t: &[TableRow]) {
         "## Results\n\nns / sample: the time one sample of the strategy's stream takes (mean over \
          seeds); relMSE x time: relMSE at {spp} spp times the seconds those samples take per \
          pixel, the error at equal work (lower is better), which charges a costly emitter \
-         choice (exhaustive is O(N)) for its time.\n"
+         choice (exhaustive is O(N)) for its time; counted per sample: rays traced (camera, \
+         shadow, BSDF), BSDF and light-density evaluations, and emitters the emitter choice \
+         weighed, the same on every machine.\n"
     );
     let _ = writeln!(
         md,
-        "| case | strategy | non-finite | mean | z | relMSE@{spp} | ns / sample | relMSE x time | max sample | top 0.1 % | slope | verdict |"
+        "| case | strategy | non-finite | mean | z | relMSE@{spp} | ns / sample | relMSE x time | rays / sample | evals / sample | choice evals / sample | max sample | top 0.1 % | slope | verdict |"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        md,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     for r in t {
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {:.2} | {} | {:.0} | {} | {} | {} | {} | {}{} |",
+            "| {} | {} | {} | {} | {:.2} | {} | {:.0} | {} | {} | {} | {} | {} | {} | {} | {}{} |",
             r.case,
             r.label,
             r.non_finite,
@@ -164,6 +178,9 @@ fn results(md: &mut String, o: &ProbeOutcome, t: &[TableRow]) {
             r.ns_per_sample,
             // The error at equal work: relMSE at spp times the time those samples take.
             sci(r.relmse * r.ns_per_sample * 1e-9 * spp as f64),
+            counted(r, |p| p.rays),
+            counted(r, |p| p.evals),
+            counted(r, |p| p.choice_evals),
             sci(r.max_sample),
             if r.top_share.is_nan() {
                 "—".into()

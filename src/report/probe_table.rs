@@ -1,5 +1,6 @@
 //! The probe report's table: every (case, strategy) pooled over seeds, with its verdict.
 
+use crate::counts::Counts;
 use crate::experiment::analysis::series;
 use crate::experiment::probe::run::{CaseRun, ProbeOutcome};
 use crate::experiment::probe::stats::z_score;
@@ -26,7 +27,30 @@ pub struct TableRow {
     pub slope: Option<f64>,
     /// Time per sample, mean over seeds (the stream's draw, shading included).
     pub ns_per_sample: f64,
+    /// What one sample did, counted over every seed's stream (None for rows without counts).
+    pub per_sample: Option<PerSample>,
     pub verdict: &'static str,
+}
+
+/// Counted work per camera sample: rays traced (camera, shadow, BSDF), BSDF and light-density
+/// evaluations, and emitters the emitter choice weighed (N per choice for the exhaustive one).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PerSample {
+    pub rays: f64,
+    pub evals: f64,
+    pub choice_evals: f64,
+}
+
+impl PerSample {
+    /// Per camera sample of the summed counts `c`; None without a camera ray.
+    pub fn of(c: &Counts) -> Option<PerSample> {
+        let n = c.camera_rays as f64;
+        (n > 0.0).then(|| PerSample {
+            rays: c.rays() as f64 / n,
+            evals: (c.bsdf_evals + c.light_pdf_evals) as f64 / n,
+            choice_evals: c.choice_evals as f64 / n,
+        })
+    }
 }
 
 /// The spp whose relMSE the table shows.
@@ -117,6 +141,12 @@ fn pooled(o: &ProbeOutcome, c: &CaseRun, name: &str, label: &str) -> Option<Tabl
         top_share: worst(|r| r.top_share),
         slope,
         ns_per_sample: per_seed.iter().map(|r| 1e9 / r.samples_per_s).sum::<f64>() / s,
+        per_sample: per_seed
+            .iter()
+            .filter_map(|r| r.counts())
+            .reduce(|a, b| a + b)
+            .as_ref()
+            .and_then(PerSample::of),
         verdict: "",
     })
 }
@@ -146,4 +176,36 @@ fn alpha(o: &ProbeOutcome) -> f64 {
 /// The table's critical |z|: two-sided at the experiment's alpha, Šidák over `rows` tests.
 pub fn critical(o: &ProbeOutcome, rows: usize) -> f64 {
     crate::experiment::probe::stats::z_critical(alpha(o), rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Hand-computed: 10 camera samples that cast 10 camera, 5 shadow and 2 BSDF rays, made
+    /// 4 BSDF and 3 light-density evaluations and weighed 100 emitters in their choices (an
+    /// exhaustive choice over 10 emitters): 1.7 rays, 0.7 evaluations and 10 choice
+    /// evaluations per sample. No camera ray, no figure.
+    #[test]
+    fn counted_work_per_sample_by_hand() {
+        let c = Counts {
+            camera_rays: 10,
+            shadow_rays: 5,
+            bsdf_rays: 2,
+            bsdf_evals: 4,
+            light_pdf_evals: 3,
+            choice_evals: 100,
+            ..Counts::default()
+        };
+        let p = PerSample::of(&c).unwrap();
+        assert_eq!(
+            p,
+            PerSample {
+                rays: 1.7,
+                evals: 0.7,
+                choice_evals: 10.0
+            }
+        );
+        assert_eq!(PerSample::of(&Counts::default()), None);
+    }
 }

@@ -5,6 +5,7 @@ use super::e;
 use crate::experiment::analysis::{
     error_of, metric_label, metric_name, metric_short, predicted_of, Series,
 };
+use crate::experiment::costs::Costs;
 use crate::experiment::results::{Row, EQUAL_TIME};
 use crate::experiment::runner::Outcome;
 use crate::experiment::schema::ErrorMetric;
@@ -217,18 +218,29 @@ pub(super) fn diagnostics(md: &mut String, o: &Outcome, series: &[Series]) {
     md.push('\n');
 }
 
-pub(super) fn equal_time_table(md: &mut String, o: &Outcome) {
-    let rows: Vec<&Row> = o.rows.iter().filter(|r| r.kind == EQUAL_TIME).collect();
+pub(super) fn equal_time_table(md: &mut String, o: &Outcome, costs: Option<&Costs>) {
+    let rows: Vec<(usize, &Row)> = o
+        .rows
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.kind == EQUAL_TIME)
+        .collect();
     if rows.is_empty() {
         return;
     }
     let m = o.exp.exp.metrics.primary;
     let what = metric_name(m, o.exp.exp.metrics.relmse_epsilon);
-    let _ = writeln!(md, "## Equal time\n\nspp chosen from each strategy's measured sample rate.\n\n| budget (s) | strategy | seed | spp | seconds | {what} |\n|---|---|---|---|---|---|");
-    for r in rows {
+    let _ = writeln!(md, "## Equal time\n\nspp chosen from each strategy's measured sample rate; each run's measured seconds, its rays per camera sample and its modelled seconds (Counted cost).\n\n| budget (s) | strategy | seed | spp | seconds | rays per sample | modelled seconds | {what} |\n|---|---|---|---|---|---|---|---|");
+    for (i, r) in rows {
+        let rays = r.counts().map_or("-".into(), |c| {
+            format!("{:.3}", c.rays() as f64 / c.camera_rays.max(1) as f64)
+        });
+        let modelled = costs
+            .and_then(|c| c.modelled[i])
+            .map_or("-".into(), |s| format!("{s:.2}"));
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {:.2} | {} |",
+            "| {} | {} | {} | {} | {:.2} | {rays} | {modelled} | {} |",
             r.budget_s,
             r.name,
             r.seed,

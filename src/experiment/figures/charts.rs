@@ -1,7 +1,10 @@
-//! Convergence charts: error against spp and against time, and efficiency.
+//! Convergence charts: error against spp, against time and against counted cost, and
+//! efficiency.
 
 use super::Figure;
 use crate::experiment::analysis::{metric_label, metric_name, metric_short, series, Point, Series};
+use crate::experiment::costs::Costs;
+use crate::experiment::results::Row;
 use crate::experiment::runner::Outcome;
 use crate::experiment::schema::ErrorMetric;
 use crate::plot::{write_chart, Line, LogLogChart};
@@ -66,6 +69,41 @@ pub fn charts(o: &Outcome) -> Result<(Vec<Series>, Vec<Figure>), String> {
         },
         "Error against render time (the same runs): lower-left is better.".into(),
     )?;
+    if let Some(costs) = Costs::of(o) {
+        let at = |s: &Series, p: &Point| {
+            let pick = |r: &Row| r.is_sweep() && r.strategy == s.label && r.spp == p.spp;
+            Some((costs.mean(&o.rows, pick)?, p.error))
+        };
+        chart(
+            "error_vs_cost",
+            LogLogChart {
+                title: format!("{what} vs counted cost"),
+                x_label: "modelled seconds (counted rays and evaluations)".into(),
+                y_label: what.clone(),
+                lines: ss
+                    .iter()
+                    .map(|s| Line {
+                        points: s.points.iter().filter_map(|p| at(s, p)).collect(),
+                        spread: s
+                            .points
+                            .iter()
+                            .filter(|p| at(s, p).is_some())
+                            .map(|p| (p.min, p.max))
+                            .collect(),
+                        ..line(s, &|p| (p.seconds, p.error))
+                    })
+                    .collect(),
+                hline: Some((floor, "reference noise floor".into())),
+            },
+            format!(
+                "Error against counted cost (the same runs): each run's rays and evaluations \
+                 weighed by the cost per unit fitted on this experiment's {} runs \
+                 (see Counted cost), so two estimators compare by the work they do rather than \
+                 by how fast their code or sampler happens to run.",
+                costs.model.runs
+            ),
+        )?;
+    }
     let eff: Vec<Line> = ss
         .iter()
         .map(|s| Line {

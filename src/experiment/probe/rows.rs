@@ -33,7 +33,7 @@ pub(crate) fn rows(
         .map(|&k| {
             let mse = batch_mse(x, k as usize, info.reference);
             let predicted = st.variance / k as f64;
-            Row {
+            let mut row = Row {
                 context: info.context.to_string(),
                 case: info.case.to_string(),
                 strategy: info.label.clone(),
@@ -78,7 +78,10 @@ pub(crate) fn rows(
                 flip: None,
                 exposure: None,
                 ..Default::default()
-            }
+            };
+            // The k samples of the row did k / n of what the stream did.
+            row.set_counts_share(&drawn.counts, k as f64 / n);
+            row
         })
         .collect()
 }
@@ -103,7 +106,16 @@ mod tests {
             eps: 0.0,
             seconds: 2.0,
         };
-        let r = rows(&info, &x, &Drawn::default(), &st, &[1, 2]);
+        // The stream of 64 samples cast 64 camera rays and 32 shadow rays.
+        let drawn = Drawn {
+            counts: crate::counts::Counts {
+                camera_rays: 64,
+                shadow_rays: 32,
+                ..Default::default()
+            },
+            ..Drawn::default()
+        };
+        let r = rows(&info, &x, &drawn, &st, &[1, 2]);
         assert_eq!(r.len(), 2);
         assert_eq!((r[0].spp, r[1].spp), (1, 2));
         assert_eq!(r[0].mse, 1.0);
@@ -113,5 +125,8 @@ mod tests {
         assert_eq!(r[0].z, Some(0.0));
         assert_eq!(r[0].max_sample, Some(2.0));
         assert_eq!(r[0].case, "c");
+        // Each row did its share of the stream's work: 2 of 64 samples, 2 camera rays.
+        assert_eq!((r[1].camera_rays, r[1].shadow_rays), (Some(2.0), Some(1.0)));
+        assert_eq!(r[0].counts().unwrap().camera_rays, 1);
     }
 }

@@ -1,6 +1,7 @@
 //! The individual sample values of one pixel, drawn exactly as `render` draws them (same
 //! seeding, camera ray and estimator), for statistics a mean and variance cannot give.
 
+use crate::counts::Counts;
 use crate::integrator::Direct;
 use crate::rng::Rng;
 
@@ -8,6 +9,8 @@ use crate::rng::Rng;
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Drawn {
     pub non_finite: u64,
+    /// What the samples did (rays, evaluations), all of them.
+    pub counts: Counts,
     /// Per-channel mean and sample variance (of one sample), for the image-mean columns.
     pub mean: [f64; 3],
     pub variance: [f64; 3],
@@ -34,7 +37,7 @@ pub fn pixel_samples(
     for s in 0..n {
         let mut rng = Rng::for_sample(seed, pixel, s as u64);
         let ray = cam.generate_ray(x, y, &mut rng);
-        let v = direct.li(&ray, &mut rng);
+        let v = direct.li_counted(&ray, &mut rng, &mut d.counts);
         let v = if v.is_finite() {
             v
         } else {
