@@ -157,14 +157,14 @@ fn check_rows(out: &std::path::Path) {
     assert_eq!(sections["load_build"], 1, "{sections:?}");
     // Each goal of light, BSDF, one-sample and solid-angle against power MIS, per thread count.
     assert_eq!(sections["throughput_ratio"], 4 * 2, "{sections:?}");
-    // The cost model: one coefficient per term, its error on the 16 runs it was fitted on
-    // (7 strategies at two spp, two MIS sample-count mixes) and the 6 it never saw.
+    // The cost model: one coefficient per term, its error on the 20 runs it was fitted on
+    // (7 strategies at two spp, six other mixes of techniques) and the 6 it never saw.
     assert_eq!(
         sections["cost_model"],
         directlab::cost::TERMS.len(),
         "{sections:?}"
     );
-    assert_eq!(sections["cost_prediction_error_fitted"], 16, "{sections:?}");
+    assert_eq!(sections["cost_prediction_error_fitted"], 20, "{sections:?}");
     assert_eq!(
         sections["cost_prediction_error_held_out"], 6,
         "{sections:?}"

@@ -53,17 +53,42 @@ pub fn held_out() -> Vec<Strategy> {
     ]
 }
 
-/// Configurations fitted besides the bench strategies: MIS with two samples of one technique,
-/// so the cost of a light sample and of a BSDF sample can be told apart (in the bench
-/// strategies every estimator takes one of each, or one alone).
+/// Configurations fitted besides the bench strategies, so that each technique's counts vary
+/// apart from the others' (in the bench strategies every estimator takes one sample of each
+/// technique, or one alone, and the model could trade one term for another): MIS with two
+/// light or two BSDF samples, light sampling with two, BSDF sampling with three, light
+/// sampling alone in solid angle (solid-angle samples without solid-angle densities), and
+/// one-sample MIS choosing the BSDF technique two times in three.
 fn design() -> Vec<Strategy> {
     let mis = bench_strategies()[0];
+    let light = Strategy {
+        kind: StrategyKind::Light,
+        ..mis
+    };
     vec![
         Strategy {
             emitter_samples: 2,
             ..mis
         },
         Strategy {
+            bsdf_samples: 2,
+            ..mis
+        },
+        Strategy {
+            emitter_samples: 2,
+            ..light
+        },
+        Strategy {
+            kind: StrategyKind::Bsdf,
+            bsdf_samples: 3,
+            ..mis
+        },
+        Strategy {
+            light_sampling: LightSampling::SolidAngle,
+            ..light
+        },
+        Strategy {
+            kind: StrategyKind::MisOneSample,
             bsdf_samples: 2,
             ..mis
         },

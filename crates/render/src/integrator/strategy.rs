@@ -200,6 +200,13 @@ mod tests {
                 kind: StrategyKind::MisOneSample,
                 ..base
             },
+            // One-sample MIS picks the light technique with c = ne / (ne + nb): another
+            // estimator (it once had the label of the one above).
+            Strategy {
+                kind: StrategyKind::MisOneSample,
+                bsdf_samples: 2,
+                ..base
+            },
         ];
         let mut labels: Vec<String> = variants.iter().map(Strategy::label).collect();
         labels.push(base.label());

@@ -35,7 +35,12 @@ impl Estimator for MisOneSample {
         t.bsdf(bsdf, bsdf_w, 1.0);
     }
 
-    fn label(_: &Strategy, h: &str, sel: &str, ls: &str) -> String {
-        format!("{h}-{sel}-{ls}")
+    /// The sample counts set the technique probability c, so they are part of the label
+    /// unless they are one each (c = 1/2; labels of results written before stay valid).
+    fn label(s: &Strategy, h: &str, sel: &str, ls: &str) -> String {
+        match (s.emitter_samples, s.bsdf_samples) {
+            (1, 1) => format!("{h}-{sel}-{ls}"),
+            (e, b) => format!("{h}-e{e}b{b}-{sel}-{ls}"),
+        }
     }
 }
