@@ -10,6 +10,7 @@
 
 use crate::counts::Counts;
 use crate::emitter::LightSampling;
+use crate::rng::LANES;
 use crate::scene::desc::StrategyKind;
 use crate::stats::nnls::nnls;
 
@@ -18,8 +19,11 @@ use crate::stats::nnls::nnls;
 /// evaluation in solid angle (spherical triangles and cones cost several times an area
 /// sample: trigonometry in f64), and a cost per camera sample for each estimator that is not
 /// two-sample MIS: how it runs its techniques (light or BSDF sampling alone skip the step
-/// MIS shares between them; one-sample MIS splits each group of lanes between two steps).
-pub const TERMS: [&str; 16] = [
+/// MIS shares between them; one-sample MIS splits each group of lanes between two steps),
+/// and a cost per batch of `LANES` camera samples of a pixel: a render at fewer samples per
+/// pixel than lanes runs whole batches with lanes idle (1, 2 and 4 spp take about the time
+/// of 8), which no count of work shows.
+pub const TERMS: [&str; 17] = [
     "render",
     "pixel",
     "camera_ray",
@@ -36,6 +40,7 @@ pub const TERMS: [&str; 16] = [
     "light_only_camera_sample",
     "bsdf_only_camera_sample",
     "one_sample_camera_sample",
+    "lane_batch",
 ];
 
 /// What one render did: its size, its counts, its estimator and how it drew light points.
@@ -53,6 +58,9 @@ impl Work {
         let c = self.counts.values().map(|v| v as f64);
         let sa = f64::from(u8::from(self.light_sampling == LightSampling::SolidAngle));
         let kind = |k| f64::from(u8::from(self.kind == k)) * c[0];
+        // Every pixel takes the same spp, so camera rays / pixels is it.
+        let spp = self.counts.camera_rays / self.pixels.max(1);
+        let batches = self.pixels * spp.div_ceil(LANES as u64);
         [
             1.0,
             self.pixels as f64,
@@ -70,6 +78,7 @@ impl Work {
             kind(StrategyKind::Light),
             kind(StrategyKind::Bsdf),
             kind(StrategyKind::MisOneSample),
+            batches as f64,
         ]
     }
 }
@@ -158,13 +167,16 @@ mod tests {
         assert_eq!(&t[..5], &[1.0, 100.0, 400.0, 400.0, 400.0]);
         assert_eq!(t[9], 133.0);
         assert_eq!((t[11], t[12]), (400.0, 133.0));
-        assert_eq!(&t[13..], &[0.0; 3]);
+        assert_eq!(&t[13..16], &[0.0; 3]);
+        // 4 spp on 100 pixels: one batch of eight lanes per pixel; 9 spp would be two.
+        assert_eq!(t[16], 100.0);
+        assert_eq!(work(9, 2, true).terms()[16], 200.0);
         let t = work(4, 2, false).terms();
         assert_eq!((t[11], t[12]), (0.0, 0.0));
         let t = work_of(4, 2, false, StrategyKind::MisOneSample).terms();
-        assert_eq!(&t[13..], &[0.0, 0.0, 400.0]);
+        assert_eq!(&t[13..16], &[0.0, 0.0, 400.0]);
         let t = work_of(4, 2, false, StrategyKind::Light).terms();
-        assert_eq!(&t[13..], &[400.0, 0.0, 0.0]);
+        assert_eq!(&t[13..16], &[400.0, 0.0, 0.0]);
     }
 
     #[test]
