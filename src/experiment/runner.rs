@@ -445,12 +445,20 @@ pub fn run_experiment(exp: Resolved, opts: &RunOptions) -> Result<Outcome, Strin
     );
     let mut bar = Progress::new(&exp.name, samples, runs);
     let mut rendered = 0;
+    // The file holds exactly the kept rows from here on (rows of another context dropped), so
+    // each new run is appended; a run that replaces one rewrites the file.
+    results.save(&csv)?;
     let mut commit = |row: Row, spp: u64, results: &mut Results, bar: &mut Progress| {
+        let before = results.rows.len();
         results.rows.retain(|r| !same_run(r, &row));
         bar.run_done(spp * pixels);
         rendered += 1;
         events::result(&exp.name, &row);
-        results.push_and_save(row, &csv)
+        if results.rows.len() == before {
+            results.push_and_append(row, &csv)
+        } else {
+            results.push_and_save(row, &csv)
+        }
     };
     for job in &jobs {
         commit(execute(&ctx, job)?, job.spp as u64, &mut results, &mut bar)?;
