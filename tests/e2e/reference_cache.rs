@@ -1,7 +1,7 @@
 //! The reference cache through `directlab run`: a reference made by another renderer build is
 //! rendered again, and the run, its `--json` events and its report say why.
 
-mod common;
+use crate::common;
 
 use common::{directlab, run, scratch};
 use std::path::Path;

@@ -1,8 +1,8 @@
 //! End to end through the `directlab render` command, as a user runs it.
 
+use crate::common;
 use directlab::film::read_exr;
 use directlab::metrics::compare_regions;
-mod common;
 
 use common::{directlab, repo, run, scratch};
 use std::path::{Path, PathBuf};

@@ -8,7 +8,7 @@
 //! unit files goes) leaves the merge cancelled and `status` naming the unit and its shard;
 //! submitting again sends that shard only and completes the run without redoing a unit.
 
-mod common;
+use crate::common;
 use common::{
     directlab, plan_of, reference_bytes, run, scratch, sweep_rows, tiny_experiment, unit_files,
 };

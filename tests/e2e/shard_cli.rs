@@ -3,7 +3,7 @@
 //! rows (timing columns aside); finished units are skipped; missing, truncated and foreign
 //! unit files, stale plans and shards out of range are named, and nothing is merged then.
 
-mod common;
+use crate::common;
 use common::{
     directlab, plan_of, reference_bytes, repo, run, scratch, sweep_rows, tiny_experiment,
     unit_files,

@@ -6,7 +6,7 @@
 //! fails it, and a screenshot must not be blank. Without Chromium the test says why and is
 //! skipped, unless DIRECTLAB_REQUIRE_CHROMIUM=1 (set by `.ci/run` once it is installed).
 
-mod common;
+use crate::common;
 use common::{directlab, repo, run, scratch};
 use std::path::Path;
 use std::process::Command;

@@ -2,7 +2,7 @@
 //! from is printed and written to the CSV, with finite, positive numbers. (The numbers
 //! themselves are the benchmark's business, not a test's.)
 
-mod common;
+use crate::common;
 
 use common::{directlab, repo, run, scratch};
 use std::collections::HashMap;

@@ -21,7 +21,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Output;
 
-mod common;
+use crate::common;
 
 fn experiment(quick: bool) -> Resolved {
     load(&repo("experiments/extreme.toml"), quick).expect("extreme.toml loads")

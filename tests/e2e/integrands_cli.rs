@@ -2,7 +2,7 @@
 //! per (integrand, sampler) with a published rate where the paper has one, the CSV a row
 //! per (integrand, sampler, N), a chart per integrand; bad arguments are refused.
 
-mod common;
+use crate::common;
 
 use common::{directlab, run, scratch};
 

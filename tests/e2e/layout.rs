@@ -3,7 +3,7 @@
 //! harness itself); the experiment runner never calls the report writer or the commands above
 //! it (reports read results); and every source file reads in one sitting (600 lines at most).
 
-mod common;
+use crate::common;
 
 use common::repo;
 use std::path::{Path, PathBuf};

@@ -1,6 +1,6 @@
 //! Helpers shared by the end-to-end tests: paths into the repository, scratch directories,
 //! and running the `directlab` binary.
-// Each test binary compiles this module and uses only part of it.
+// Every test file uses part of it.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};

@@ -3,7 +3,7 @@
 //! every strategy's image at the comparison spp and at equal time, embedded as HDR data)
 //! stays a few MB; with `--viewer none` it carries no image data at all.
 
-mod common;
+use crate::common;
 use common::{directlab, repo, run, scratch};
 
 /// fig3.toml with its [quick] sizes but the scene's own resolution.

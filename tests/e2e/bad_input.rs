@@ -3,7 +3,7 @@
 //! what was at the output path as it was. Cases that used to hang or run for minutes run
 //! under a watchdog (`within`): the test fails if they outlast it.
 
-mod common;
+use crate::common;
 
 use common::{directlab, repo, scratch};
 use std::os::unix::fs::{FileTypeExt, PermissionsExt};

@@ -2,7 +2,7 @@
 //! reference fails, bad files give clear errors), and scenes whose integrator is a path
 //! tracer (refused by `render`, rendered as their direct part with `--integrator direct`).
 
-mod common;
+use crate::common;
 use common::{directlab, repo, run, scratch};
 use glam::DVec3;
 use std::path::Path;

@@ -3,7 +3,7 @@
 //! `experiments/README.md` lists equal what is registered, so a plug-in added or renamed
 //! without its documentation fails here.
 
-mod common;
+use crate::common;
 
 use common::repo;
 use directlab::emitter::RULES;

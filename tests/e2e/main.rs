@@ -1,0 +1,21 @@
+//! The end-to-end tests, through the command line, in one test binary: as fifteen binaries,
+//! each linked with the release profile's thin LTO, their linking was most of a fresh
+//! `cargo test --release`.
+
+mod common;
+
+mod bad_input;
+mod bench_cli;
+mod browser;
+mod experiment_cli;
+mod extreme;
+mod html_page;
+mod integrands_cli;
+mod layout;
+mod noritest_cli;
+mod readme;
+mod reference_cache;
+mod render_cli;
+mod shard_cli;
+mod slurm_e2e;
+mod strategies_agree;
