@@ -16,13 +16,11 @@ use crate::stats::nnls::nnls;
 
 /// The terms of the model, in coefficient order: per render, per pixel, per counter (in
 /// `Counts::values` order), the extra cost of a light sample and a light-density
-/// evaluation in solid angle (spherical triangles and cones cost several times an area
-/// sample: trigonometry in f64), and a cost per camera sample for each estimator that is not
-/// two-sample MIS: how it runs its techniques (light or BSDF sampling alone skip the step
-/// MIS shares between them; one-sample MIS splits each group of lanes between two steps),
-/// and a cost per batch of `LANES` camera samples of a pixel: a render at fewer samples per
-/// pixel than lanes runs whole batches with lanes idle (1, 2 and 4 spp take about the time
-/// of 8), which no count of work shows.
+/// evaluation in solid angle (spherical triangles and cones: trigonometry in f64), a cost per
+/// camera sample for each estimator that is not two-sample MIS (how it runs its techniques:
+/// light or BSDF sampling alone skip the step MIS shares between them; one-sample MIS runs
+/// both steps over each group of lanes), and a cost per batch of `LANES` camera samples of a
+/// pixel: below `LANES` spp a batch runs with lanes idle, which no count of work shows.
 pub const TERMS: [&str; 17] = [
     "render",
     "pixel",
@@ -42,6 +40,11 @@ pub const TERMS: [&str; 17] = [
     "one_sample_camera_sample",
     "lane_batch",
 ];
+
+/// `v` per camera sample of the render that counted `c` (0 for a render without any).
+pub fn per_camera_sample(c: &Counts, v: u64) -> f64 {
+    v as f64 / c.camera_rays.max(1) as f64
+}
 
 /// What one render did: its size, its counts, its estimator and how it drew light points.
 #[derive(Clone, Copy, Debug)]

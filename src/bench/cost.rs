@@ -4,7 +4,7 @@
 //! third. Its prediction error on those is the honest figure: on the fitted runs it can only
 //! look good.
 
-use super::timing::timed;
+use super::timing::{best_of_turns, timed};
 use super::{bench_strategies, BenchArgs, Row};
 use crate::cost::{CostModel, Work, TERMS};
 use crate::emitter::{EmitterSelection, LightSampling};
@@ -15,7 +15,7 @@ use crate::scene::Scene;
 
 /// Configurations the model is not fitted on: other sample counts per camera sample, other
 /// mixes of techniques.
-pub fn held_out() -> Vec<Strategy> {
+fn held_out() -> Vec<Strategy> {
     let mis = bench_strategies()[0];
     vec![
         Strategy {
@@ -152,16 +152,12 @@ pub(super) fn section(scene: &Scene, name: &str, a: &BenchArgs, rows: &mut Vec<R
         "    {:<30} {:>5} {:>10} {:>10} {:>8}",
         "strategy", "spp", "measured s", "modelled s", "error"
     );
-    let mut worst_held = 0.0f64;
     for (runs, section, kind) in [
         (&fit, "cost_prediction_error_fitted", "fitted"),
         (&held, "cost_prediction_error_held_out", "held out"),
     ] {
         for r in runs {
             let error = model.error(&r.work, r.seconds);
-            if kind == "held out" {
-                worst_held = worst_held.max(error.abs());
-            }
             println!(
                 "    {:<30} {:>5} {:>10.3} {:>10.3} {:>+7.1}%  {kind}",
                 r.strategy.label(),
@@ -181,35 +177,37 @@ pub(super) fn section(scene: &Scene, name: &str, a: &BenchArgs, rows: &mut Vec<R
             });
         }
     }
+    let worst_held = held
+        .iter()
+        .map(|r| model.error(&r.work, r.seconds).abs())
+        .fold(0.0, f64::max);
     println!(
         "    worst held-out prediction error {:.1}% (goal: within 10%)",
         worst_held * 100.0
     );
 }
 
-/// Each configuration rendered `repeat` times on one thread, in turns (as the throughput
-/// section times them); the fastest time of each.
+/// Each configuration rendered `repeat` times on one thread, in turns (the throughput
+/// section's schedule); the fastest time of each.
 fn time_in_turns(scene: &Scene, pixels: u64, configs: &[(Strategy, u32)], repeat: u32) -> Vec<Run> {
-    let mut best: Vec<Option<Run>> = configs.iter().map(|_| None).collect();
-    for _ in 0..repeat.max(1) {
-        for (b, &(strategy, spp)) in best.iter_mut().zip(configs) {
-            let (seconds, _, counts) = timed(scene, strategy, SamplerKind::Independent, spp, 1);
-            if b.as_ref().is_none_or(|b| seconds < b.seconds) {
-                *b = Some(Run {
-                    strategy,
-                    spp,
-                    work: Work {
-                        pixels,
-                        counts,
-                        kind: strategy.kind,
-                        light_sampling: strategy.light_sampling,
-                    },
-                    seconds,
-                });
-            }
-        }
-    }
-    best.into_iter().flatten().collect()
+    let timed = best_of_turns(configs, &[1], repeat, |(strategy, spp), t| {
+        timed(scene, strategy, SamplerKind::Independent, spp, t)
+    });
+    configs
+        .iter()
+        .zip(timed)
+        .map(|(&(strategy, spp), t)| Run {
+            strategy,
+            spp,
+            work: Work {
+                pixels,
+                counts: t[0].counts,
+                kind: strategy.kind,
+                light_sampling: strategy.light_sampling,
+            },
+            seconds: t[0].seconds(),
+        })
+        .collect()
 }
 
 /// Seconds per unit in ns, with enough digits for a per-render constant and a per-ray cost.

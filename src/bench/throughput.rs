@@ -116,37 +116,20 @@ pub(super) fn section(scene: &Scene, name: &str, a: &BenchArgs, rows: &mut Vec<R
 /// sampling 0.7x of area sampling. None for power MIS itself and strategies without a goal.
 fn goal(s: &Strategy) -> Option<(f64, &'static str)> {
     let mis = power_mis();
-    if *s
-        == (Strategy {
-            kind: StrategyKind::Light,
-            ..mis
-        })
-    {
-        Some((1.2, "light sampling alone"))
-    } else if *s
-        == (Strategy {
-            kind: StrategyKind::Bsdf,
-            ..mis
-        })
-    {
-        Some((1.2, "BSDF sampling alone"))
-    } else if *s
-        == (Strategy {
-            kind: StrategyKind::MisOneSample,
-            ..mis
-        })
-    {
-        Some((1.1, "one-sample MIS"))
-    } else if *s
-        == (Strategy {
-            light_sampling: LightSampling::SolidAngle,
-            ..mis
-        })
-    {
-        Some((0.7, "solid angle against area"))
-    } else {
-        None
-    }
+    let kind = |kind| Strategy { kind, ..mis };
+    let solid_angle = Strategy {
+        light_sampling: LightSampling::SolidAngle,
+        ..mis
+    };
+    [
+        (kind(StrategyKind::Light), 1.2, "light sampling alone"),
+        (kind(StrategyKind::Bsdf), 1.2, "BSDF sampling alone"),
+        (kind(StrategyKind::MisOneSample), 1.1, "one-sample MIS"),
+        (solid_angle, 0.7, "solid angle against area"),
+    ]
+    .into_iter()
+    .find(|(g, _, _)| g == s)
+    .map(|(_, want, what)| (want, what))
 }
 
 /// Each strategy's samples/s over power MIS's at each thread count, paired by repetition

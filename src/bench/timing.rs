@@ -2,6 +2,7 @@
 //! every (strategy, thread count) takes its turn.
 
 use super::least;
+use crate::cost::per_camera_sample;
 use crate::counts::Counts;
 use crate::integrator::Strategy;
 use crate::render::{render, RenderSettings};
@@ -33,7 +34,12 @@ pub struct Timed {
 impl Timed {
     /// Rays traced per camera sample (camera, shadow and BSDF rays past the bounds test).
     pub fn rays_per_sample(&self) -> f64 {
-        self.counts.rays() as f64 / self.counts.camera_rays.max(1) as f64
+        per_camera_sample(&self.counts, self.counts.rays())
+    }
+
+    /// Seconds of the fastest render.
+    pub fn seconds(&self) -> f64 {
+        self.counts.camera_rays as f64 / self.samples_per_s
     }
 }
 
@@ -50,9 +56,7 @@ pub fn throughputs(
     threads: &[usize],
     repeat: u32,
 ) -> Vec<Vec<Timed>> {
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let samples = w as f64 * h as f64 * spp as f64;
-    best_of_turns(strategies, threads, repeat, samples, |strategy, t| {
+    best_of_turns(strategies, threads, repeat, |strategy, t| {
         timed(scene, strategy, SamplerKind::Independent, spp, t)
     })
 }
@@ -90,21 +94,18 @@ pub fn sampler_throughputs(
     threads: &[usize],
     repeat: u32,
 ) -> Vec<Vec<Timed>> {
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let samples = w as f64 * h as f64 * spp as f64;
-    best_of_turns(samplers, threads, repeat, samples, |kind, t| {
+    best_of_turns(samplers, threads, repeat, |kind, t| {
         timed(scene, strategy, kind, spp, t)
     })
 }
 
-/// `throughputs`' schedule and bookkeeping around `time`, which renders `samples` camera
-/// samples with one configuration (a strategy, a sampler) and a thread count and returns
+/// `throughputs`' schedule and bookkeeping around `time`, which renders one configuration
+/// (a strategy, a sampler, a sample count) with a thread count and returns
 /// (seconds, busy worker seconds, what it did).
-fn best_of_turns<T: Copy>(
+pub(super) fn best_of_turns<T: Copy>(
     strategies: &[T],
     threads: &[usize],
     repeat: u32,
-    samples: f64,
     mut time: impl FnMut(T, usize) -> (f64, f64, Counts),
 ) -> Vec<Vec<Timed>> {
     let mut best: Vec<Vec<Option<Timed>>> = vec![vec![None; threads.len()]; strategies.len()];
@@ -113,6 +114,7 @@ fn best_of_turns<T: Copy>(
         for ((&strategy, best), runs) in strategies.iter().zip(&mut best).zip(&mut runs) {
             for ((b, runs), &t) in best.iter_mut().zip(runs.iter_mut()).zip(threads) {
                 let (seconds, busy_seconds, counts) = time(strategy, t);
+                let samples = counts.camera_rays as f64;
                 let samples_per_s = samples / seconds;
                 runs.push(samples_per_s);
                 if b.as_ref().is_none_or(|b| samples_per_s > b.samples_per_s) {
@@ -157,7 +159,7 @@ mod tests {
         let strategies = &bench_strategies()[..3];
         let threads = [1, 2];
         let mut calls = Vec::new();
-        let timed = best_of_turns(strategies, &threads, 4, 1e6, |s, t| {
+        let timed = best_of_turns(strategies, &threads, 4, |s, t| {
             let spell = if calls.len() < strategies.len() * threads.len() {
                 2.0
             } else {
@@ -171,7 +173,12 @@ mod tests {
                 .position(|x| x.label() == s.label())
                 .unwrap();
             let seconds = spell / ((k + 1) as f64 * t as f64);
-            (seconds, seconds * t as f64 * 0.5, Counts::default())
+            // Every render draws 1e6 camera samples.
+            let counts = Counts {
+                camera_rays: 1_000_000,
+                ..Counts::default()
+            };
+            (seconds, seconds * t as f64 * 0.5, counts)
         });
         let turn: Vec<_> = strategies
             .iter()

@@ -1,5 +1,5 @@
-//! `results.csv`: one row per render, rewritten atomically after every row so an interrupted
-//! sweep resumes where it stopped. Rows carry a `context` hash (reference key + epsilon): rows
+//! `results.csv`: one row per render, appended after every run (the file rewritten
+//! atomically when a run replaces one) so an interrupted sweep resumes where it stopped. Rows carry a `context` hash (reference key + epsilon): rows
 //! made against another scene, reference or epsilon are dropped on load, never mixed in.
 
 use crate::counts::Counts;
@@ -214,10 +214,9 @@ impl Results {
     }
 
     /// Adds `row` to the table and appends it to `path` as one line, which must hold exactly
-    /// the table's other rows (as `save` wrote them). Rewriting the whole file after each run
-    /// made a sweep quadratic: fig4's 4,000 runs wrote about 5 GB of CSV. A run killed while
-    /// appending leaves a partial last line, which `load` drops like any unreadable row (it
-    /// is rendered again).
+    /// the table's other rows (as `save` wrote them): rewriting the whole file after each run
+    /// makes a sweep's writing quadratic in its runs. A run killed while appending leaves a
+    /// partial last line, which `load` drops like any unreadable row (it is rendered again).
     pub fn push_and_append(&mut self, row: Row, path: &Path) -> Result<(), String> {
         let empty = std::fs::metadata(path).map_or(true, |m| m.len() == 0);
         if empty {

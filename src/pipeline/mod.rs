@@ -5,6 +5,7 @@
 
 pub mod shard;
 
+use crate::experiment::costs::Costs;
 use crate::experiment::events;
 use crate::experiment::probe::{self, ProbeOutcome};
 use crate::experiment::{figures, load, metric, run_experiment, Outcome, RunOptions};
@@ -25,9 +26,11 @@ pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(),
 pub fn report_outcome(o: &Outcome, viewer: Viewer) -> Result<(), String> {
     metric::write_long(&o.dir.join("metrics.csv"), &o.rows)?;
     events::write_jsonl(&o.dir.join("results.jsonl"), &o.rows)?;
-    let (series, mut figs) = figures::charts(o)?;
+    // One fit of the cost model for the chart and the report.
+    let costs = Costs::of(o);
+    let (series, mut figs) = figures::charts(o, costs.as_ref())?;
     figs.extend(figures::images(o)?);
-    crate::report::write_experiment(o, &series, &figs, viewer)?;
+    crate::report::write_experiment(o, &series, &figs, costs.as_ref(), viewer)?;
     for l in crate::report::mean_check_lines(o) {
         events::say(&format!("{}: {l}", o.exp.name));
     }

@@ -145,6 +145,7 @@ pub fn write_experiment(
     o: &Outcome,
     series: &[Series],
     figures: &[Figure],
+    costs: Option<&Costs>,
     viewer: html::Viewer,
 ) -> Result<(), String> {
     let mut md = String::new();
@@ -162,12 +163,11 @@ pub fn write_experiment(
     tables::rate_table(&mut md, o, series);
     tables::metrics_table(&mut md, o);
     tables::diagnostics(&mut md, o, series);
-    let costs = Costs::of(o);
-    tables::equal_time_table(&mut md, o, costs.as_ref());
+    tables::equal_time_table(&mut md, o, costs);
     ratios::gains(&mut md, o);
     means::means(&mut md, o);
     tables::variance_table(&mut md, o);
-    if let Some(c) = &costs {
+    if let Some(c) = costs {
         cost::cost_section(&mut md, &o.rows, &o.strategies, c, o.exp.equal_spp());
     }
     let _ = writeln!(md, "## Figures\n");

@@ -1,5 +1,6 @@
 //! The probe report's table: every (case, strategy) pooled over seeds, with its verdict.
 
+use crate::cost::per_camera_sample;
 use crate::counts::Counts;
 use crate::experiment::analysis::series;
 use crate::experiment::probe::run::{CaseRun, ProbeOutcome};
@@ -44,11 +45,10 @@ pub struct PerSample {
 impl PerSample {
     /// Per camera sample of the summed counts `c`; None without a camera ray.
     pub fn of(c: &Counts) -> Option<PerSample> {
-        let n = c.camera_rays as f64;
-        (n > 0.0).then(|| PerSample {
-            rays: c.rays() as f64 / n,
-            evals: (c.bsdf_evals + c.light_pdf_evals) as f64 / n,
-            choice_evals: c.choice_evals as f64 / n,
+        (c.camera_rays > 0).then(|| PerSample {
+            rays: per_camera_sample(c, c.rays()),
+            evals: per_camera_sample(c, c.bsdf_evals + c.light_pdf_evals),
+            choice_evals: per_camera_sample(c, c.choice_evals),
         })
     }
 }

@@ -2,6 +2,7 @@
 //! variance.
 
 use super::e;
+use crate::cost::per_camera_sample;
 use crate::experiment::analysis::{
     error_of, metric_label, metric_name, metric_short, predicted_of, Series,
 };
@@ -233,7 +234,7 @@ pub(super) fn equal_time_table(md: &mut String, o: &Outcome, costs: Option<&Cost
     let _ = writeln!(md, "## Equal time\n\nspp chosen from each strategy's measured sample rate; each run's measured seconds, its rays per camera sample and its modelled seconds (Counted cost).\n\n| budget (s) | strategy | seed | spp | seconds | rays per sample | modelled seconds | {what} |\n|---|---|---|---|---|---|---|---|");
     for (i, r) in rows {
         let rays = r.counts().map_or("-".into(), |c| {
-            format!("{:.3}", c.rays() as f64 / c.camera_rays.max(1) as f64)
+            format!("{:.3}", per_camera_sample(&c, c.rays()))
         });
         let modelled = costs
             .and_then(|c| c.modelled[i])

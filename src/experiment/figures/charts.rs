@@ -9,7 +9,8 @@ use crate::experiment::runner::Outcome;
 use crate::experiment::schema::ErrorMetric;
 use crate::plot::{write_chart, Line, LogLogChart};
 
-pub fn charts(o: &Outcome) -> Result<(Vec<Series>, Vec<Figure>), String> {
+/// The charts of `o`; the error-vs-cost chart where its runs have a cost model (`costs`).
+pub fn charts(o: &Outcome, costs: Option<&Costs>) -> Result<(Vec<Series>, Vec<Figure>), String> {
     let m = o.exp.exp.metrics.primary;
     let eps = o.exp.exp.metrics.relmse_epsilon;
     let what = metric_name(m, eps);
@@ -69,10 +70,23 @@ pub fn charts(o: &Outcome) -> Result<(Vec<Series>, Vec<Figure>), String> {
         },
         "Error against render time (the same runs): lower-left is better.".into(),
     )?;
-    if let Some(costs) = Costs::of(o) {
-        let at = |s: &Series, p: &Point| {
-            let pick = |r: &Row| r.is_sweep() && r.strategy == s.label && r.spp == p.spp;
-            Some((costs.mean(&o.rows, pick)?, p.error))
+    if let Some(costs) = costs {
+        // Each point at its runs' mean modelled seconds; a point without a model value
+        // (rows from before counts were recorded) is left out with its bar.
+        let costed = |s: &Series| -> Line {
+            let at: Vec<(&Point, f64)> = s
+                .points
+                .iter()
+                .filter_map(|p| {
+                    let pick = |r: &Row| r.is_sweep() && r.strategy == s.label && r.spp == p.spp;
+                    Some((p, costs.mean(&o.rows, pick)?))
+                })
+                .collect();
+            Line {
+                points: at.iter().map(|(p, x)| (*x, p.error)).collect(),
+                spread: at.iter().map(|(p, _)| (p.min, p.max)).collect(),
+                ..line(s, &|p| (p.seconds, p.error))
+            }
         };
         chart(
             "error_vs_cost",
@@ -80,19 +94,7 @@ pub fn charts(o: &Outcome) -> Result<(Vec<Series>, Vec<Figure>), String> {
                 title: format!("{what} vs counted cost"),
                 x_label: "modelled seconds (counted rays and evaluations)".into(),
                 y_label: what.clone(),
-                lines: ss
-                    .iter()
-                    .map(|s| Line {
-                        points: s.points.iter().filter_map(|p| at(s, p)).collect(),
-                        spread: s
-                            .points
-                            .iter()
-                            .filter(|p| at(s, p).is_some())
-                            .map(|p| (p.min, p.max))
-                            .collect(),
-                        ..line(s, &|p| (p.seconds, p.error))
-                    })
-                    .collect(),
+                lines: ss.iter().map(costed).collect(),
                 hline: Some((floor, "reference noise floor".into())),
             },
             format!(
