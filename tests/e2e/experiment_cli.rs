@@ -412,7 +412,7 @@ fn quick_fig4_crosses_samplers_and_reports_rates() {
     // runs (seeds) of each column.
     assert_eq!(csv.lines().count() - 1, 3 * 6 * 3 * 4 + 3 * 6 * 4, "{csv}");
     // Four seeds at equal time, so each equal-time ratio can have an interval (at this size
-    // the errors are at the quick reference's noise floor and the report says "—").
+    // some errors are at the quick reference's noise floor and the report says "—" there).
     let seeds: std::collections::BTreeSet<&str> = csv
         .lines()
         .filter(|l| l.contains(",\"light, independent\",time,"))
@@ -455,10 +455,15 @@ fn quick_fig4_crosses_samplers_and_reports_rates() {
         .filter(|l| l.starts_with("| ") && l.contains(", "))
         .collect();
     assert_eq!(gains.len(), 17, "every column but the first");
-    assert!(
-        gains.iter().all(|l| l.matches("x [").count() == 3),
-        "{gains:?}"
-    );
+    // Error, efficiency and time ratios at 16 spp always have their interval; the equal-time
+    // ratio has one, or "—" where the quick reference's noise floor hides the error (which
+    // columns reach it depends on the machine's speed).
+    for row in &gains {
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        assert_eq!(cells.len(), 7, "{row}");
+        assert!(cells[2..5].iter().all(|c| c.contains("x [")), "{row}");
+        assert!(cells[5] == "—" || cells[5].contains("x ["), "{row}");
+    }
     std::fs::remove_dir_all(&out).unwrap();
 }
 
