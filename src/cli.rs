@@ -177,7 +177,7 @@ pub struct RenderArgs {
     /// Scene file (XML).
     pub scene: PathBuf,
     /// Samples per pixel (default: the scene's sampler).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = crate::limits::parse_spp)]
     pub spp: Option<u32>,
     /// Seed (default: the scene's sampler seed).
     #[arg(long)]
@@ -291,11 +291,6 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
     };
     settings.sampler_config((scene.camera.width, scene.camera.height))?;
     let result = render(&scene, strategy, &settings);
-    film::write_exr(&out, &result.mean)?;
-    film::write_png(&out.with_extension("png"), &result.mean)?;
-    if let Some(v) = &a.variance {
-        film::write_exr(v, &result.variance)?;
-    }
     let stats = RenderStats {
         scene: a.scene.display().to_string(),
         strategy: strategy.label(),
@@ -312,12 +307,22 @@ fn cmd_render(a: &RenderArgs) -> Result<(), String> {
         mean_rgb: result.mean.mean_rgb(),
         direct_part_of: scene.desc.integrator.direct_part_of.clone(),
     };
-    if let Some(p) = &a.stats {
-        let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
-        crate::output::write_atomic(p, |tmp| {
-            std::fs::write(tmp, json).map_err(|e| format!("{}: {e}", p.display()))
-        })?;
-    }
+    // The image, its preview, variance and statistics replace the old ones as one set: a
+    // disk that fills part-way leaves the old files, never a new EXR beside an old PNG.
+    crate::output::as_one_set(|| {
+        film::write_exr(&out, &result.mean)?;
+        film::write_png(&out.with_extension("png"), &result.mean)?;
+        if let Some(v) = &a.variance {
+            film::write_exr(v, &result.variance)?;
+        }
+        if let Some(p) = &a.stats {
+            let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;
+            crate::output::write_atomic(p, |tmp| {
+                std::fs::write(tmp, json).map_err(|e| format!("{}: {e}", p.display()))
+            })?;
+        }
+        Ok(())
+    })?;
     eprintln!(
         "{}: {}x{} at {} spp with {} in {:.2} s ({:.2} M samples/s) -> {}",
         a.scene.display(),

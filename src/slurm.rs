@@ -6,6 +6,7 @@
 //! Slurm's own scheduler does the scheduling; directlab only writes and submits the scripts.
 
 use crate::experiment::args::{options, SweepArgs};
+use crate::experiment::events::{emit, say};
 use crate::experiment::shard::units::Stage;
 use crate::experiment::shard::{self, Planned, Status};
 use clap::{Args, Subcommand};
@@ -322,7 +323,13 @@ fn submit(file: &Path, a: &SubmitArgs) -> Result<(), String> {
     let st = shard::status_of(&p);
     let steps = steps(&p, &st, n, &common);
     if steps.is_empty() {
-        println!("{name}: nothing to submit: every unit is done and the results are merged");
+        say(&format!(
+            "{name}: nothing to submit: every unit is done and the results are merged"
+        ));
+        emit(
+            "slurm_nothing_to_submit",
+            serde_json::json!({ "experiment": name }),
+        );
         return Ok(());
     }
     let scripts = dir.join("slurm");
@@ -339,12 +346,19 @@ fn submit(file: &Path, a: &SubmitArgs) -> Result<(), String> {
                 Some(d) => format!(" --dependency=afterok:<{d}> --kill-on-invalid-dep=yes"),
                 None => String::new(),
             };
-            println!(
+            say(&format!(
                 "# {name}: {} ({what}): sbatch --parsable{dep} {}",
                 step.label,
                 path.display()
+            ));
+            say(&text);
+            emit(
+                "slurm_script",
+                serde_json::json!({
+                    "experiment": name, "step": step.label, "script": path,
+                    "array": step.array, "text": text,
+                }),
             );
-            println!("{text}");
             prev = Some(step.label.to_string());
             continue;
         }
@@ -353,17 +367,26 @@ fn submit(file: &Path, a: &SubmitArgs) -> Result<(), String> {
             std::fs::write(tmp, &text).map_err(|e| format!("{}: {e}", path.display()))
         })?;
         let id = sbatch(&path, prev.as_deref())?;
-        println!("{name}: submitted {} ({what}) as job {id}", step.label);
+        say(&format!(
+            "{name}: submitted {} ({what}) as job {id}",
+            step.label
+        ));
+        emit(
+            "slurm_submitted",
+            serde_json::json!({
+                "experiment": name, "step": step.label, "job": id, "array": step.array,
+            }),
+        );
         prev = Some(id);
     }
     if !a.dry_run {
-        println!(
+        say(&format!(
             "{name}: logs in {}; `directlab status {} --out {}{}` shows progress",
             site.logs.display(),
             file.display(),
             a.sweep.out.display(),
             if a.sweep.quick { " --quick" } else { "" }
-        );
+        ));
     }
     Ok(())
 }

@@ -20,7 +20,7 @@ pub struct Chi2Args {
     /// Run only cases whose name contains this (e.g. `emitter/`, `grazing`).
     pub filter: Option<String>,
     /// Samples per case.
-    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, default_value_t = 1_000_000, value_parser = crate::limits::parser("--samples", 1, crate::limits::TEST_SAMPLES))]
     pub samples: u64,
     /// Cells along a domain's v axis (the sphere gets 2R-1 rows of cos(theta), R of phi):
     /// 3 to 2048 (2048 is 8.4 million cells a case, about 200 MB of tables per case run).

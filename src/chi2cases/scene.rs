@@ -25,8 +25,16 @@ pub fn cases(
 ) -> (Vec<Case>, Vec<String>) {
     let mut out = Vec::new();
     let mut left = Vec::new();
+    // A BSDF shared by many shapes (a grid of lights over one floor) is tested once.
+    let mut distinct: Vec<usize> = Vec::new();
+    let mut repeats = 0;
     for (k, m) in scene.materials.iter().enumerate() {
         let ty = m.kind.type_name();
+        if distinct.iter().any(|&j| scene.materials[j] == *m) {
+            repeats += 1;
+            continue;
+        }
+        distinct.push(k);
         if m.kind.is_delta() {
             left.push(format!(
                 "material {k} ({ty}): all-delta, it has no density to test"
@@ -41,6 +49,11 @@ pub fn cases(
                 run_bsdf(&label, &m, m.kind.glossy_lobe(), wi, cfg)
             }));
         }
+    }
+    if repeats > 0 {
+        left.push(format!(
+            "{repeats} material(s) with the same BSDF and parameters as one tested already"
+        ));
     }
     let triangles: usize = scene
         .shapes

@@ -142,6 +142,31 @@ impl Accum {
     }
 }
 
+impl Accum {
+    /// Checks what no render can produce: a mean that is not finite (non-finite samples are
+    /// counted and left out), a negative or non-finite sum of squares, a negative time. Names
+    /// the first bad pixel.
+    pub fn check_values(&self) -> Result<(), String> {
+        if !(self.seconds.is_finite() && self.seconds >= 0.0) {
+            return Err(format!("its time {} s is not a duration", self.seconds));
+        }
+        let w = self.width.max(1) as usize;
+        for (i, (m, m2)) in self.mean.iter().zip(&self.m2).enumerate() {
+            let ok =
+                m.iter().all(|v| v.is_finite()) && m2.iter().all(|v| v.is_finite() && *v >= 0.0);
+            if !ok {
+                return Err(format!(
+                    "pixel ({}, {}) holds mean {m:?} and sum of squares {m2:?}; a render gives \
+                     finite means and non-negative sums",
+                    i % w,
+                    i / w
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// A cursor over little-endian bytes.
 pub struct Reader<'a> {
     b: &'a [u8],

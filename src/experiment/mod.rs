@@ -13,6 +13,7 @@ pub mod costs;
 pub mod events;
 pub mod figures;
 pub mod leftout;
+pub mod lock;
 mod measure;
 pub mod method;
 pub mod metric;

@@ -90,9 +90,16 @@ pub(crate) fn plan_sweep(results: &Results, kept: &[(String, Method)], sw: &Swee
     jobs
 }
 
-/// Loads a kept image and its variance.
+/// Loads a kept image and its variance (the new versions while a merge writes its outputs as
+/// one set).
 pub fn load_image(p: &Path) -> Result<(Image, Image), String> {
-    Ok((film::read_exr(p)?, film::read_exr(&variance_path(p))?))
+    let read = |p: &Path| {
+        film::read_exr(&crate::output::pending(p)).map_err(|e| {
+            let shown = crate::output::pending(p);
+            e.replace(&shown.display().to_string(), &p.display().to_string())
+        })
+    };
+    Ok((read(p)?, read(&variance_path(p))?))
 }
 
 #[cfg(test)]

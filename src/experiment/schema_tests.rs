@@ -253,7 +253,13 @@ fn image_sweeps_take_one_scene_and_a_rendered_or_constant_reference() {
     assert!(e.contains("[reference] needs spp"), "{e}");
     let eps0 = EXAMPLE.replace("relmse_epsilon = 0.001", "relmse_epsilon = 0");
     let e = resolve(parse(&eps0, &file()).unwrap(), &file(), false).unwrap_err();
-    assert!(e.contains("relmse_epsilon must be positive"), "{e}");
+    assert!(
+        e.contains("relmse_epsilon = 0: expected a finite positive"),
+        "{e}"
+    );
+    let inf = EXAMPLE.replace("relmse_epsilon = 0.001", "relmse_epsilon = inf");
+    let e = resolve(parse(&inf, &file()).unwrap(), &file(), false).unwrap_err();
+    assert!(e.contains("relmse_epsilon = inf"), "{e}");
 }
 
 #[test]

@@ -4,6 +4,7 @@
 use super::cases::{merge_defines, Case, CaseReferenceSpec, CaseSpec, MIN_BATCHES};
 use super::schema::ErrorMetric;
 use super::schema::Experiment;
+use crate::limits;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -69,6 +70,15 @@ pub(crate) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
     if exp.seeds == 0 {
         return fail("`seeds` must be at least 1".into());
     }
+    let spps = exp.spp.iter().map(|&s| ("spp", s));
+    for (what, s) in spps.chain(exp.reference.spp.map(|s| ("reference.spp", s))) {
+        if let Err(e) = limits::count(s as u64, what, limits::SPP) {
+            return fail(e);
+        }
+    }
+    if let Err(e) = limits::count(exp.seeds as u64, "seeds", limits::SEEDS) {
+        return fail(e);
+    }
     for (what, v) in [
         ("figures.equal_spp", exp.figures.equal_spp),
         ("figures.variance_spp", exp.figures.variance_spp),
@@ -94,8 +104,11 @@ pub(crate) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
     }
     // A closed-form reference may be 0, where relMSE then falls back to the MSE.
     let eps = exp.metrics.relmse_epsilon;
-    if !(eps > 0.0 || (eps == 0.0 && exp.probe.is_some())) {
-        return fail("metrics.relmse_epsilon must be positive (0 is allowed in probe mode)".into());
+    if !(eps > 0.0 && eps.is_finite() || (eps == 0.0 && exp.probe.is_some())) {
+        return fail(format!(
+            "metrics.relmse_epsilon = {eps}: expected a finite positive number (0 is allowed in \
+             probe mode); an infinite one makes every relMSE 0"
+        ));
     }
     let m = &exp.metrics;
     if !matches!(m.primary, ErrorMetric::Mse | ErrorMetric::Relmse) {
@@ -124,6 +137,19 @@ pub(crate) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
                 .map(|e| format!("\"{}\"", e.slug()))
                 .collect::<Vec<_>>()
                 .join(", ")
+        ));
+    }
+    if let Some((i, x)) = m
+        .report
+        .iter()
+        .enumerate()
+        .find(|(i, x)| m.report[..*i].contains(x))
+    {
+        return fail(format!(
+            "metrics.report lists \"{}\" twice (entries {} and {})",
+            x.slug(),
+            m.report.iter().position(|y| y == x).expect("found") + 1,
+            i + 1
         ));
     }
     let mut names: Vec<&str> = exp.strategies.iter().map(|s| s.name.as_str()).collect();

@@ -13,20 +13,21 @@ use std::path::{Path, PathBuf};
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct IntegrandsArgs {
-    /// Independent randomisations (seeds) per sample count.
-    #[arg(long, default_value_t = 256)]
-    pub seeds: u64,
-    /// Largest sample count N (powers of two from 16, and the off-grid 2^(k + 1/2) between).
-    #[arg(long, default_value_t = 4096)]
-    pub max_n: u32,
+    /// Independent randomisations (seeds) per sample count [default: 256, 32 with --quick].
+    #[arg(long)]
+    pub seeds: Option<u64>,
+    /// Largest sample count N (powers of two from 16, and the off-grid 2^(k + 1/2) between)
+    /// [default: 4096, 256 with --quick].
+    #[arg(long)]
+    pub max_n: Option<u64>,
     /// Samplers to compare, comma-separated (default: all).
     #[arg(long, value_parser = crate::choices::named::<SamplerKind>(), value_delimiter = ',')]
     pub samplers: Vec<SamplerKind>,
     /// Reports folder; the report is written to `<out>/integrands/`.
     #[arg(long, default_value = "reports")]
     pub out: PathBuf,
-    /// Reduced size (32 seeds, N up to 256; tests and smoke runs), written to
-    /// `<out>/integrands-quick/`.
+    /// Reduced size (32 seeds, N up to 256, unless --seeds or --max-n say otherwise; tests
+    /// and smoke runs), written to `<out>/integrands-quick/`.
     #[arg(long)]
     pub quick: bool,
     /// `none`: the HTML report links its figures instead of carrying them.
@@ -37,8 +38,8 @@ pub struct IntegrandsArgs {
 impl Default for IntegrandsArgs {
     fn default() -> Self {
         IntegrandsArgs {
-            seeds: 256,
-            max_n: 4096,
+            seeds: None,
+            max_n: None,
             samplers: Vec::new(),
             out: PathBuf::from("reports"),
             quick: false,
@@ -47,33 +48,55 @@ impl Default for IntegrandsArgs {
     }
 }
 
+impl IntegrandsArgs {
+    /// Seeds and largest N: as given, else the full or quick defaults; bounded.
+    fn size(&self) -> Result<(u64, u32), String> {
+        let seeds = self.seeds.unwrap_or(if self.quick { 32 } else { 256 });
+        let max_n = self.max_n.unwrap_or(if self.quick { 256 } else { 4096 });
+        if seeds < 2 {
+            return Err(format!(
+                "--seeds {seeds}: the RMSE and its bootstrap interval need at least 2"
+            ));
+        }
+        crate::limits::count(seeds, "--seeds", crate::limits::SEEDS)?;
+        if max_n < 32 {
+            return Err(format!(
+                "--max-n {max_n}: a slope needs two powers of two from 16, so at least 32"
+            ));
+        }
+        let max_n = crate::limits::count(max_n, "--max-n", MAX_N)?;
+        Ok((seeds, max_n as u32))
+    }
+}
+
+/// The largest N: each count is a run of every sampler over every seed.
+const MAX_N: crate::limits::Bound = crate::limits::Bound {
+    max: 1 << 20,
+    why: "the rates settle by N = 4096; a larger N only adds hours",
+};
+
 /// A slope agrees with a published one when its interval holds it or they differ by at
 /// most this (the paper reads its rates off plots, to about a tenth).
 const AGREE: f64 = 0.1;
 
 /// Runs the integrands and writes the report; returns its folder.
 pub fn run(a: &IntegrandsArgs) -> Result<PathBuf, String> {
-    let quick = IntegrandsArgs {
-        seeds: 32,
-        max_n: 256,
-        quick: false,
-        ..a.clone()
-    };
-    let (a, name) = if a.quick {
-        (&quick, "integrands-quick")
+    let name = if a.quick {
+        "integrands-quick"
     } else {
-        (a, "integrands")
+        "integrands"
     };
-    if a.seeds < 2 {
+    let (seeds, max_n) = a.size()?;
+    if let Some((i, k)) = a
+        .samplers
+        .iter()
+        .enumerate()
+        .find(|(i, k)| a.samplers[..*i].contains(k))
+    {
         return Err(format!(
-            "--seeds {}: the RMSE and its bootstrap interval need at least 2",
-            a.seeds
-        ));
-    }
-    if a.max_n < 32 {
-        return Err(format!(
-            "--max-n {}: a slope needs two powers of two from 16, so at least 32",
-            a.max_n
+            "--samplers lists {} twice (entry {}); each sampler is measured once",
+            k.name(),
+            i + 1
         ));
     }
     let samplers: Vec<SamplerKind> = if a.samplers.is_empty() {
@@ -81,9 +104,9 @@ pub fn run(a: &IntegrandsArgs) -> Result<PathBuf, String> {
     } else {
         a.samplers.clone()
     };
-    let counts = sample_counts(a.max_n);
+    let counts = sample_counts(max_n);
     let start = std::time::Instant::now();
-    let cells = measure(&samplers, &counts, a.seeds)?;
+    let cells = measure(&samplers, &counts, seeds)?;
     let dir = a.out.join(name);
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     write_csv(&dir.join("results.csv"), &cells)?;
@@ -93,18 +116,18 @@ pub fn run(a: &IntegrandsArgs) -> Result<PathBuf, String> {
         write_chart(&dir.join(&stem), &chart(&cells, &samplers, i, *f))?;
         charts.push(stem);
     }
-    let mut md = index(a, &samplers, &counts, &cells, &charts);
+    let mut md = index((seeds, max_n), &samplers, &counts, &cells, &charts);
     // The renderer costs more per sample than a 2D pair: the pixel check stops at 1024.
-    let pixel_counts = sample_counts(a.max_n.min(1024));
-    let pixel_cells = pixel::measure(&pixel_counts, a.seeds)?;
-    md += &pixel_section(&dir, &pixel_cells, &pixel_counts, a.seeds)?;
+    let pixel_counts = sample_counts(max_n.min(1024));
+    let pixel_cells = pixel::measure(&pixel_counts, seeds)?;
+    md += &pixel_section(&dir, &pixel_cells, &pixel_counts, seeds)?;
     crate::report::write_report(&dir, &md, None, a.viewer)?;
     let path = dir.join("index.md");
     eprintln!(
         "integrands: {} samplers x {} counts x {} seeds in {:.1} s; report in {}",
         samplers.len(),
         counts.len(),
-        a.seeds,
+        seeds,
         start.elapsed().as_secs_f64(),
         path.display()
     );
@@ -298,7 +321,7 @@ fn why(k: SamplerKind) -> &'static str {
 }
 
 fn index(
-    a: &IntegrandsArgs,
+    (seeds, max_n): (u64, u32),
     samplers: &[SamplerKind],
     counts: &[u32],
     cells: &[Cell],
@@ -324,9 +347,9 @@ fn index(
          Written by `directlab integrands --seeds {} --max-n {}` (and by `reproduce`).\n",
         counts[0],
         counts.last().copied().unwrap_or(0),
-        a.seeds,
-        a.seeds,
-        a.max_n
+        seeds,
+        seeds,
+        max_n
     );
     let _ = writeln!(
         md,

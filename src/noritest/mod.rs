@@ -25,7 +25,7 @@ pub struct TestArgs {
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// Samples per test instead of the file's `sampleCount` (smoke runs).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(2..))]
+    #[arg(long, value_parser = crate::limits::parser("--samples", 2, crate::limits::TEST_SAMPLES))]
     pub samples: Option<u64>,
     /// Test every directlab strategy on every scene, also where the scene names one.
     #[arg(long)]
@@ -78,6 +78,16 @@ fn run_chi2(f: &parse::TestFile, a: &TestArgs) -> Result<bool, String> {
     let mut rng = Rng::new(a.seed, 0x6e6f7269);
     let mut cases = Vec::new();
     for b in &f.bsdfs {
+        // A delta BSDF has no density: its chi-square has no degrees of freedom, and would
+        // "pass" without testing anything.
+        if b.value.kind.is_delta() {
+            eprintln!(
+                "warning: {}: {} is all-delta (no density to bin); left out of the chi2test",
+                f.path.display(),
+                b.label
+            );
+            continue;
+        }
         for k in 0..f.test_count {
             let wi = square_to_cosine_hemisphere(rng.next_2d());
             let name = format!("line{}-{}/wi{k}", b.line, b.value.kind.type_name());
@@ -89,12 +99,30 @@ fn run_chi2(f: &parse::TestFile, a: &TestArgs) -> Result<bool, String> {
             }));
         }
     }
+    if cases.is_empty() {
+        return Err(format!(
+            "{}: no BSDF of this chi2test has a density to test (all are delta: mirror, \
+             dielectric); it would pass with 0 degrees of freedom",
+            f.path.display()
+        ));
+    }
     let r = 2 * f.resolution as usize;
+    let samples = match (a.samples, f.samples) {
+        (Some(n), _) => n,
+        (None, Some(n)) => n,
+        (None, None) => crate::limits::count(
+            5000 * 2 * (f.resolution as u64).pow(2),
+            &format!(
+                "{}: the samples of each case (Nori's default of 5000 per bin at resolution {}; \
+                 give sampleCount)",
+                f.path.display(),
+                f.resolution
+            ),
+            crate::limits::TEST_SAMPLES,
+        )?,
+    };
     let cfg = CaseConfig {
-        samples: a
-            .samples
-            .or(f.samples)
-            .unwrap_or(5000 * 2 * (f.resolution as u64).pow(2)),
+        samples,
         resolution: r,
         seed: a.seed,
         alpha: crate::stats::sidak(f.alpha, cases.len()),

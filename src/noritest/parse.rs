@@ -94,7 +94,9 @@ pub fn read(path: &Path, defines: &[(String, String)]) -> Result<TestFile, Scene
             "significanceLevel must lie in (0, 1), found {alpha}"
         )));
     }
-    let samples = p.count("sample_count")?.map(u64::from);
+    let samples = p
+        .bounded("sample_count", crate::limits::TEST_SAMPLES)?
+        .map(u64::from);
     if samples.is_some_and(|n| n < 2) {
         let e = p.element_of("sample_count").unwrap_or(&root);
         return Err(e.err("sampleCount must be at least 2"));
@@ -137,7 +139,9 @@ pub fn read(path: &Path, defines: &[(String, String)]) -> Result<TestFile, Scene
                 )));
             }
             f.min_expected = p.count("min_exp_frequency")?.unwrap_or(5) as f64;
-            f.test_count = p.count("test_count")?.unwrap_or(5);
+            f.test_count = p
+                .bounded("test_count", crate::limits::TEST_COUNT)?
+                .unwrap_or(5);
             if f.test_count == 0 {
                 let e = p.element_of("test_count").unwrap_or(&root);
                 return Err(e.err("testCount must be at least 1"));

@@ -16,6 +16,9 @@ use std::path::Path;
 /// sweeps) or the table's summary (probe mode).
 pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(), String> {
     let exp = load(file, quick)?;
+    // Held until the report is written: one run at a time per experiment folder.
+    let _lock = crate::experiment::lock::acquire(&opts.out.join(&exp.name))
+        .map_err(|e| format!("{}: {e}", file.display()))?;
     if exp.exp.probe.is_some() {
         return report_probe(&probe::run_probe(exp, opts)?, opts.viewer);
     }
@@ -24,13 +27,17 @@ pub fn run_and_report(file: &Path, quick: bool, opts: &RunOptions) -> Result<(),
 
 /// Writes the figures and report of a finished sweep and prints its summary.
 pub fn report_outcome(o: &Outcome, viewer: Viewer) -> Result<(), String> {
-    metric::write_long(&o.dir.join("metrics.csv"), &o.rows)?;
-    events::write_jsonl(&o.dir.join("results.jsonl"), &o.rows)?;
-    // One fit of the cost model for the chart and the report.
-    let costs = Costs::of(o);
-    let (series, mut figs) = figures::charts(o, costs.as_ref())?;
-    figs.extend(figures::images(o)?);
-    crate::report::write_experiment(o, &series, &figs, costs.as_ref(), viewer)?;
+    // The report's files replace the old ones as one set: an error part-way leaves the old
+    // report whole.
+    crate::output::as_one_set(|| {
+        metric::write_long(&o.dir.join("metrics.csv"), &o.rows)?;
+        events::write_jsonl(&o.dir.join("results.jsonl"), &o.rows)?;
+        // One fit of the cost model for the chart and the report.
+        let costs = Costs::of(o);
+        let (series, mut figs) = figures::charts(o, costs.as_ref())?;
+        figs.extend(figures::images(o)?);
+        crate::report::write_experiment(o, &series, &figs, costs.as_ref(), viewer)
+    })?;
     for l in crate::report::mean_check_lines(o) {
         events::say(&format!("{}: {l}", o.exp.name));
     }
@@ -61,9 +68,11 @@ pub fn report_outcome(o: &Outcome, viewer: Viewer) -> Result<(), String> {
 
 /// Writes the figure and report of a finished probe experiment and prints its summary.
 pub fn report_probe(o: &ProbeOutcome, viewer: Viewer) -> Result<(), String> {
-    let figure = probe::figure::write(o)?;
-    crate::report::probe::write(o, figure.as_deref(), viewer)?;
-    events::write_jsonl(&o.dir.join("results.jsonl"), &o.rows)?;
+    crate::output::as_one_set(|| {
+        let figure = probe::figure::write(o)?;
+        crate::report::probe::write(o, figure.as_deref(), viewer)?;
+        events::write_jsonl(&o.dir.join("results.jsonl"), &o.rows)
+    })?;
     events::emit(
         "report_written",
         serde_json::json!({

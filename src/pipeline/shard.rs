@@ -26,7 +26,7 @@ pub struct PlanArgs {
     #[arg(required = true)]
     pub experiments: Vec<PathBuf>,
     /// Shard count `status` assumes (a shard's units follow from this count alone).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, default_value_t = 1, value_parser = shard::parse_shards)]
     pub shards: u32,
     #[command(flatten)]
     pub sweep: SweepArgs,
@@ -50,7 +50,7 @@ pub struct StatusArgs {
     #[arg(required = true)]
     pub experiments: Vec<PathBuf>,
     /// Name the shards of this count that own missing units (default: the plan's).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = shard::parse_shards)]
     pub shards: Option<u32>,
     #[command(flatten)]
     pub sweep: SweepArgs,
@@ -95,8 +95,18 @@ pub fn cmd_run_shard(
 pub fn cmd_merge(a: &MergeArgs) -> Result<(), String> {
     let opts = options(&a.sweep);
     each(&a.experiments, |f| {
-        if let Some(m) = merge::merge(f, a.sweep.quick, &opts, a.stage)? {
-            super::report_outcome(&m.outcome, opts.viewer)?;
+        // Every unit is read and checked before anything is written; the images, results.csv
+        // and the report then replace the old ones as one set.
+        let name = crate::experiment::load(f, a.sweep.quick)?.name;
+        let _lock = crate::experiment::lock::acquire(&a.sweep.out.join(name))?;
+        let merged = crate::output::as_one_set(|| {
+            let m = merge::merge(f, a.sweep.quick, &opts, a.stage)?;
+            if let Some(m) = &m {
+                super::report_outcome(&m.outcome, opts.viewer)?;
+            }
+            Ok(m)
+        })?;
+        if let Some(m) = merged {
             m.mark()?;
         }
         Ok(())

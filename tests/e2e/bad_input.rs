@@ -5,45 +5,14 @@
 
 use crate::common;
 
-use common::{directlab, repo, scratch};
+use common::{directlab, fails, repo, scratch, within};
 use std::os::unix::fs::{FileTypeExt, PermissionsExt};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 fn cbox() -> String {
     repo("scenes/cbox/cbox.xml").to_str().unwrap().to_string()
-}
-
-/// Runs `cmd`, killing it and failing the test if it is still running after `secs`.
-fn within(cmd: &mut Command, secs: u64) -> Output {
-    let mut child = cmd
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("run directlab");
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > Duration::from_secs(secs) {
-            let _ = child.kill();
-            panic!("still running after {secs} s: {cmd:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.wait_with_output().unwrap()
-}
-
-/// Runs `cmd` (60 s at most) and checks that it failed with `code` and a message containing
-/// every one of `words`.
-fn fails(cmd: &mut Command, code: i32, words: &[&str]) -> String {
-    let o = within(cmd, 60);
-    let err = String::from_utf8_lossy(&o.stderr).to_string();
-    assert_eq!(o.status.code(), Some(code), "{cmd:?}\n{err}");
-    for w in words {
-        assert!(err.contains(w), "{cmd:?}: expected '{w}' in:\n{err}");
-    }
-    assert!(!err.contains("panicked"), "{err}");
-    err
 }
 
 fn render(out: &Path) -> Command {

@@ -385,15 +385,25 @@ strategy = "bsdf"
     );
     // zsobol numbers the whole film's samples in one sequence: a run past it is refused
     // before anything renders, naming the file, the film and the limit.
-    let huge = text(r#"["zsobol"]"#).replace("spp = [4, 16]", "spp = [4, 134217728]");
+    // (A 2048x2048 film, so the limit lies below the bound on any run's spp.)
+    let big = FURNACE
+        .replace(r#"name="width" value="6""#, r#"name="width" value="2048""#)
+        .replace(
+            r#"name="height" value="4""#,
+            r#"name="height" value="2048""#,
+        );
+    std::fs::write(out.join("furnace-big.xml"), big).unwrap();
+    let huge = text(r#"["zsobol"]"#)
+        .replace("spp = [4, 16]", "spp = [4, 4096]")
+        .replace("furnace.xml", "furnace-big.xml");
     std::fs::write(&exp, huge).unwrap();
     let bad = run(directlab().args(["run", exp.to_str().unwrap(), "--out", out.to_str().unwrap()]));
     let err = String::from_utf8_lossy(&bad.stderr);
     assert_eq!(bad.status.code(), Some(1), "{err}");
     assert!(
         err.contains("furnace.toml")
-            && err.contains("6x4 film")
-            && err.contains("at most 67108864 samples per pixel"),
+            && err.contains("2048x2048 film")
+            && err.contains("at most 1024 samples per pixel"),
         "{err}"
     );
     std::fs::remove_dir_all(&out).unwrap();

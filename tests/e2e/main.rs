@@ -4,6 +4,7 @@
 
 mod common;
 
+mod bad_counts;
 mod bad_input;
 mod bench_cli;
 mod browser;
@@ -17,5 +18,6 @@ mod readme;
 mod reference_cache;
 mod render_cli;
 mod shard_cli;
+mod shard_damage;
 mod slurm_e2e;
 mod strategies_agree;

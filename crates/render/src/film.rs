@@ -145,16 +145,20 @@ pub fn write_png(path: &Path, img: &Image) -> Result<(), String> {
 /// (about 16).
 pub const BYTES_PER_PIXEL: u64 = 128;
 
-/// Refuses a film whose render would not fit in the memory this machine has available (or
-/// whose pixel count is beyond what the film's indices address), before rendering starts.
+/// Refuses a film whose render would not fit in the memory this process may take (the
+/// machine's free memory, its `ulimit` and cgroup limits, [`crate::memory`]), or whose pixel
+/// count is beyond what the film's indices address, before rendering starts.
 pub fn check_film_memory(width: u32, height: u32) -> Result<(), String> {
-    check_film_memory_within(width, height, available_memory())
+    check_film_pixels(width, height)?;
+    let need = (width as u64 * height as u64).saturating_mul(BYTES_PER_PIXEL);
+    crate::memory::check(
+        need,
+        &format!("the film is {width}x{height}: rendering it ({BYTES_PER_PIXEL} bytes per pixel)"),
+    )
 }
 
-fn check_film_memory_within(width: u32, height: u32, available: Option<u64>) -> Result<(), String> {
+fn check_film_pixels(width: u32, height: u32) -> Result<(), String> {
     let pixels = width as u64 * height as u64;
-    let need = pixels.saturating_mul(BYTES_PER_PIXEL);
-    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
     if pixels > u32::MAX as u64 {
         return Err(format!(
             "the film is {width}x{height} ({pixels} pixels), more than the {} pixels an image \
@@ -162,24 +166,7 @@ fn check_film_memory_within(width: u32, height: u32, available: Option<u64>) -> 
             u32::MAX
         ));
     }
-    match available {
-        Some(avail) if need > avail => Err(format!(
-            "the film is {width}x{height}: rendering it needs about {:.1} GiB of memory \
-             ({BYTES_PER_PIXEL} bytes per pixel), and this machine has {:.1} GiB available",
-            gib(need),
-            gib(avail)
-        )),
-        _ => Ok(()),
-    }
-}
-
-/// `MemAvailable` of /proc/meminfo in bytes; None where it cannot be read (the check is then
-/// skipped rather than guessed).
-pub fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
+    Ok(())
 }
 
 #[cfg(test)]
@@ -187,18 +174,15 @@ mod tests {
     use super::*;
 
     #[test]
-    fn film_memory_is_checked_against_what_is_available() {
-        let gib = 1u64 << 30;
-        assert!(check_film_memory_within(1024, 1024, Some(gib)).is_ok());
-        // 20000^2 pixels need about 48 GiB.
-        let e = check_film_memory_within(20000, 20000, Some(24 * gib)).unwrap_err();
-        assert!(e.contains("20000x20000") && e.contains("47.7 GiB"), "{e}");
-        assert!(e.contains("24.0 GiB available"), "{e}");
+    fn film_memory_is_checked_against_the_process_limit() {
+        assert!(check_film_memory(64, 64).is_ok());
+        // 60000^2 pixels need about 429 GiB: more than any limit here allows.
+        let e = check_film_memory(60000, 60000).unwrap_err();
+        assert!(e.contains("60000x60000") && e.contains("429.2 GiB"), "{e}");
         // Beyond 32-bit pixel indices, whatever the memory.
-        let e = check_film_memory_within(70000, 70000, None).unwrap_err();
+        let e = check_film_pixels(70000, 70000).unwrap_err();
         assert!(e.contains("4900000000 pixels"), "{e}");
-        assert!(check_film_memory_within(60000, 60000, None).is_ok());
-        assert!(available_memory().is_some_and(|m| m > 0));
+        assert!(check_film_pixels(60000, 60000).is_ok());
     }
 
     #[test]

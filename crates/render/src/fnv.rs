@@ -24,6 +24,11 @@ impl Fnv {
         self.bytes(&(b.len() as u64).to_le_bytes()).bytes(b)
     }
 
+    /// The hash so far.
+    pub fn value(&self) -> u64 {
+        self.0
+    }
+
     /// The hash so far, as 16 hex digits.
     pub fn hex(&self) -> String {
         format!("{:016x}", self.0)

@@ -17,8 +17,79 @@
 //! render. Temporary files are named `<file>.tmp<pid>`; those left behind by a killed process
 //! (its pid no longer running) are removed the next time a file is written in their directory.
 
+use std::cell::RefCell;
 use std::fs::{File, Metadata};
 use std::path::{Path, PathBuf};
+
+thread_local! {
+    /// While [`as_one_set`] runs on this thread: the files written so far, as (temporary,
+    /// target), renamed into place together at its end.
+    static SET: RefCell<Option<Vec<(PathBuf, PathBuf)>>> = const { RefCell::new(None) };
+}
+
+/// Removes the temporary files of a set that did not finish (an error or a panic in it).
+struct SetGuard;
+
+impl Drop for SetGuard {
+    fn drop(&mut self) {
+        if let Some(files) = SET.with(|s| s.borrow_mut().take()) {
+            for (tmp, _) in files {
+                let _ = std::fs::remove_file(tmp);
+            }
+        }
+    }
+}
+
+/// Runs `f` with every [`write_atomic`] on this thread held back: each file is written and
+/// flushed under its temporary name, and only when `f` succeeds are they all renamed into
+/// place. A failure part-way (a full disk, a bad input found late) leaves every old file as it
+/// was, so a report is replaced as one set, never half. Reads of a file written in the set go
+/// through [`pending`]. A nested call joins the outer set.
+pub fn as_one_set<T>(f: impl FnOnce() -> Result<T, String>) -> Result<T, String> {
+    if SET.with(|s| s.borrow().is_some()) {
+        return f();
+    }
+    SET.with(|s| *s.borrow_mut() = Some(Vec::new()));
+    let guard = SetGuard;
+    let value = f()?;
+    let files = SET.with(|s| s.borrow_mut().take()).unwrap_or_default();
+    drop(guard);
+    let mut dirs = Vec::new();
+    for (k, (tmp, target)) in files.iter().enumerate() {
+        if let Err(e) = std::fs::rename(tmp, target) {
+            for (t, _) in &files[k..] {
+                let _ = std::fs::remove_file(t);
+            }
+            return Err(format!(
+                "{}: cannot rename into place: {e}",
+                target.display()
+            ));
+        }
+        if let Some(d) = target.parent().filter(|d| !dirs.contains(d)) {
+            dirs.push(d);
+        }
+    }
+    for d in dirs {
+        if let Ok(d) = File::open(d) {
+            let _ = d.sync_all();
+        }
+    }
+    Ok(value)
+}
+
+/// The file to read for `path` on this thread: the new version written in the current
+/// [`as_one_set`], if any, else `path` itself.
+pub fn pending(path: &Path) -> PathBuf {
+    let Ok(target) = resolve(path) else {
+        return path.to_path_buf();
+    };
+    SET.with(|s| {
+        s.borrow()
+            .as_ref()
+            .and_then(|files| files.iter().find(|(_, t)| *t == target))
+            .map_or_else(|| path.to_path_buf(), |(tmp, _)| tmp.clone())
+    })
+}
 
 /// Follows symbolic links to the path that is actually written (up to 40 links, as the
 /// kernel allows). A dangling link resolves to the missing file it names.
@@ -129,7 +200,7 @@ fn temp_path(target: &Path) -> PathBuf {
 }
 
 /// This machine's host name ("" if it has none), as it appears in temporary file names.
-fn host() -> String {
+pub fn host() -> String {
     let mut buf = [0u8; 256];
     // SAFETY: the buffer is valid for its length; gethostname NUL-terminates within it or
     // truncates, and the result is read up to the first NUL only.
@@ -158,7 +229,8 @@ fn temp_pid(name: &str) -> Option<u32> {
     digits.parse().ok()
 }
 
-fn process_running(pid: u32) -> bool {
+/// Whether process `pid` runs on this machine.
+pub fn process_running(pid: u32) -> bool {
     Path::new("/proc").join(pid.to_string()).exists()
 }
 
@@ -183,12 +255,43 @@ pub fn clean_stale_temps(dir: &Path) -> usize {
 }
 
 /// Checks, before any work, that `path` can be written by [`write_atomic`]: what is there may
-/// be replaced, and its directory exists (or is created) and accepts a new file.
+/// be replaced, and its directory (or, while it does not exist yet, the nearest existing one
+/// above it) accepts a new file. Nothing is created: a run that fails later leaves no empty
+/// folders behind.
 pub fn check_writable(path: &Path) -> Result<(), String> {
     let target = resolve(path)?;
     existing(path, &target)?;
-    let dir = parent_dir(&target)?;
-    let probe = temp_path(&target);
+    let mut dir = match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    while std::fs::symlink_metadata(&dir).is_err() {
+        if !dir.pop() || dir.as_os_str().is_empty() {
+            dir = PathBuf::from(".");
+            break;
+        }
+    }
+    let m = std::fs::metadata(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    if !m.is_dir() {
+        return Err(format!(
+            "{}: {} is not a directory",
+            path.display(),
+            dir.display()
+        ));
+    }
+    use std::os::unix::fs::PermissionsExt;
+    if m.permissions().mode() & 0o222 == 0 {
+        return Err(format!(
+            "{}: the directory is read-only (mode {:o})",
+            dir.display(),
+            m.permissions().mode() & 0o7777
+        ));
+    }
+    let probe = dir.join(
+        temp_path(&target)
+            .file_name()
+            .expect("a temporary file has a name"),
+    );
     File::create_new(&probe)
         .map_err(|e| format!("{}: cannot write in {}: {e}", path.display(), dir.display()))?;
     let _ = std::fs::remove_file(&probe);
@@ -254,6 +357,18 @@ pub fn write_atomic(
         File::open(&tmp)
             .and_then(|f| f.sync_all())
             .map_err(|e| format!("{}: cannot flush to disk: {e}", path.display()))?;
+        let held = SET.with(|s| match s.borrow_mut().as_mut() {
+            Some(files) => {
+                if !files.iter().any(|(_, t)| *t == target) {
+                    files.push((tmp.clone(), target.clone()));
+                }
+                true
+            }
+            None => false,
+        });
+        if held {
+            return Ok(());
+        }
         std::fs::rename(&tmp, &target)
             .map_err(|e| format!("{}: cannot rename into place: {e}", path.display()))
     });
@@ -299,6 +414,47 @@ mod tests {
         assert!(r.is_err());
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "good");
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_set_is_replaced_whole_or_not_at_all() {
+        let dir = scratch("set");
+        let (a, b) = (dir.join("a.txt"), dir.join("b.txt"));
+        put(&a, "old a").unwrap();
+        put(&b, "old b").unwrap();
+        // Fails after the first file: neither is replaced, no temporary is left.
+        let r: Result<(), String> = as_one_set(|| {
+            put(&a, "new a")?;
+            assert_eq!(std::fs::read_to_string(&a).unwrap(), "old a", "held back");
+            assert_eq!(std::fs::read_to_string(pending(&a)).unwrap(), "new a");
+            Err("disk full".into())
+        });
+        assert_eq!(r.unwrap_err(), "disk full");
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old a");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2);
+        // A panic in the set leaves the old files too.
+        let caught = std::panic::catch_unwind(|| {
+            let _ = as_one_set(|| -> Result<(), String> {
+                put(&b, "new b")?;
+                panic!("bad input found late")
+            });
+        });
+        assert!(caught.is_err());
+        assert_eq!(std::fs::read_to_string(&b).unwrap(), "old b");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2);
+        // Success: both are replaced; nested sets join the outer one.
+        as_one_set(|| {
+            put(&a, "new a")?;
+            as_one_set(|| put(&b, "new b"))?;
+            assert_eq!(std::fs::read_to_string(&b).unwrap(), "old b");
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "new a");
+        assert_eq!(std::fs::read_to_string(&b).unwrap(), "new b");
+        assert_eq!(pending(&a), a);
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 2);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -360,6 +516,9 @@ mod tests {
         assert!(e.contains("read-only"), "{e}");
         assert_eq!(std::fs::read_dir(&ro).unwrap().count(), 0);
         assert!(check_writable(&dir.join("new/deeper/x.exr")).is_ok());
+        assert!(!dir.join("new").exists(), "the check creates nothing");
+        let e = check_writable(&ro.join("new/x.exr")).unwrap_err();
+        assert!(e.contains("read-only"), "{e}");
         std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
     }

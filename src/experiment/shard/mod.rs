@@ -11,7 +11,8 @@ pub mod unitfile;
 pub mod units;
 
 use super::runner::{setup, Setup};
-use super::{load, RunOptions};
+use super::{chunks, load, RunOptions};
+use crate::limits;
 pub use status::{shards_of, status_of, Status};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -33,22 +34,41 @@ impl FromStr for ShardRef {
             .split_once('/')
             .ok_or_else(|| format!("'{s}': expected I/N (shard I of N, 0 <= I < N), e.g. 2/8"))?;
         let num = |t: &str, what: &str| {
-            t.trim().parse::<u32>().map_err(|_| {
+            t.trim().parse::<u64>().map_err(|_| {
                 format!("'{s}': the {what} '{t}' is not a whole number (expected I/N, e.g. 2/8)")
             })
         };
         let (index, count) = (num(i, "shard index")?, num(n, "shard count")?);
-        if count == 0 {
-            return Err(format!("'{s}': the shard count must be at least 1"));
-        }
-        if index >= count {
+        let count = shard_count(count).map_err(|e| format!("'{s}': {e}"))?;
+        if index >= count as u64 {
             return Err(format!(
                 "shard {index}/{count} is out of range: the {count} shard(s) are numbered 0 to {}",
                 count - 1
             ));
         }
-        Ok(ShardRef { index, count })
+        Ok(ShardRef {
+            index: index as u32,
+            count,
+        })
     }
+}
+
+/// A shard count, checked: at least 1 and within [`limits::SHARDS`] (beyond it the plan's
+/// assignment alone would take gigabytes).
+pub fn shard_count(n: u64) -> Result<u32, String> {
+    if n == 0 {
+        return Err("the shard count must be at least 1".into());
+    }
+    Ok(limits::count(n, "the shard count", limits::SHARDS)? as u32)
+}
+
+/// `--shards N` on the command line.
+pub fn parse_shards(s: &str) -> Result<u32, String> {
+    let n = s
+        .trim()
+        .parse::<u64>()
+        .map_err(|_| format!("'{s}' is not a whole number"))?;
+    shard_count(n)
 }
 
 /// An experiment with its plan.
@@ -79,14 +99,74 @@ impl Planned {
     }
 
     /// Whether unit `i` is finished: Ok(false) when absent, Err(reason) when its file is
-    /// not this unit's or is damaged.
+    /// not this unit's, is damaged or does not hold what the plan says.
     fn done(&self, i: usize) -> Result<bool, String> {
-        unitfile::is_done(&self.unit_path(i), self.owner(i))
-            .map_err(|why| format!("{}: unit file {why}", self.unit_path(i).display()))
+        let path = self.unit_path(i);
+        if std::fs::symlink_metadata(&path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound)
+        {
+            return Ok(false);
+        }
+        let r = unitfile::read(&path, self.owner(i))?;
+        self.check_unit(i, &r)
+            .map_err(|why| format!("{}: unit file {why}", path.display()))?;
+        Ok(true)
     }
 
+    /// Unit `i`'s result, checked against the plan: the film's size, the sample count, the
+    /// row's column, seed and reference. Errors name the file and its shard.
     fn read(&self, i: usize) -> Result<UnitResult, String> {
-        unitfile::read(&self.unit_path(i), self.owner(i))
+        let path = self.unit_path(i);
+        let r = unitfile::read(&path, self.owner(i))
+            .and_then(|r| {
+                self.check_unit(i, &r)
+                    .map(|_| r)
+                    .map_err(|why| format!("{}: unit file {why}", path.display()))
+            })
+            .map_err(|e| {
+                let shard = self.plan.assignment(self.plan.shards)[i];
+                format!("{e} (shard {shard}/{})", self.plan.shards)
+            })?;
+        Ok(r)
+    }
+
+    /// What unit `i`'s file must hold, given the plan and the scene.
+    fn check_unit(&self, i: usize, r: &UnitResult) -> Result<(), String> {
+        let u = &self.plan.units[i];
+        let (w, h) = (self.s.scene.camera.width, self.s.scene.camera.height);
+        let film = |a: &chunks::Accum, n: u64| {
+            if (a.width, a.height) != (w, h) || a.n != n {
+                return Err(format!(
+                    "holds {} samples of a {}x{} film; the plan says {n} of {w}x{h}",
+                    a.n, a.width, a.height
+                ));
+            }
+            Ok(())
+        };
+        if u.stage == Stage::Reference {
+            let a = r.accum.as_ref().ok_or("holds no statistics")?;
+            return film(a, u.spp as u64);
+        }
+        let row = r.row.as_ref().ok_or("holds no result row")?;
+        if row.context != self.plan.context {
+            return Err("was measured against another reference or epsilon".into());
+        }
+        let spp_ok = u.stage == Stage::Timed || row.spp == u.spp;
+        if row.strategy != u.strategy
+            || row.seed != u.seed
+            || !spp_ok
+            || (row.width, row.height) != (w, h)
+        {
+            return Err(format!(
+                "holds a row of '{}' at {} spp, seed {}, {}x{}; the plan says '{}' at {} spp, \
+                 seed {}, {w}x{h}",
+                row.strategy, row.spp, row.seed, row.width, row.height, u.strategy, u.spp, u.seed
+            ));
+        }
+        match (&r.accum, u.image) {
+            (Some(a), _) => film(a, row.spp as u64),
+            (None, true) => Err("holds no image, which the figures need".into()),
+            (None, false) => Ok(()),
+        }
     }
 
     fn merged_marker(&self) -> PathBuf {
@@ -158,7 +238,7 @@ pub fn make_plan(file: &Path, quick: bool, opts: &RunOptions, shards: u32) -> Re
     plan.save(&path)?;
     let p = Planned { s, plan };
     let count = |st| p.plan.of_stage(st).count();
-    println!(
+    super::events::say(&format!(
         "{}: plan {} -> {}: {} reference chunks, {} sweep runs, {} equal-time runs, {} shard(s)",
         p.s.exp.name,
         p.plan.id,
@@ -167,6 +247,19 @@ pub fn make_plan(file: &Path, quick: bool, opts: &RunOptions, shards: u32) -> Re
         count(Stage::Sweep),
         count(Stage::Timed),
         p.plan.shards
+    ));
+    super::events::emit(
+        "plan",
+        serde_json::json!({
+            "experiment": p.s.exp.name,
+            "plan": p.plan.id,
+            "path": Plan::path(p.dir()),
+            "units": p.plan.units.len(),
+            "reference_chunks": count(Stage::Reference),
+            "sweep_runs": count(Stage::Sweep),
+            "equal_time_runs": count(Stage::Timed),
+            "shards": p.plan.shards,
+        }),
     );
     Ok(())
 }

@@ -83,54 +83,94 @@ impl Status {
 }
 
 /// `directlab status`: prints per stage what is done, what is missing or damaged (with the
-/// shards of `shards` that own it) and whether the results are merged.
+/// shards of `shards` that own it) and whether the results are merged; with `--json`, one
+/// `status` event instead (the text goes to stderr).
 pub fn print_status(p: &Planned, shards: Option<u32>) -> Status {
     let n = shards.unwrap_or(p.plan.shards);
     let st = status_of(p);
     let name = &p.s.exp.name;
-    println!(
+    let a = p.plan.assignment(n);
+    let mut lines = vec![format!(
         "{name}: plan {} ({} units), {n} shard(s); units in {}",
         p.plan.id,
         p.plan.units.len(),
         p.plan.units_dir(p.dir()).display()
-    );
+    )];
+    let mut stages = Vec::new();
     for (stage, sp) in &st.stages {
+        let merged = *stage == Stage::Reference && st.reference_merged;
+        let rerun: Vec<u32> = if merged {
+            Vec::new()
+        } else {
+            shards_of(p, n, sp.todo()).into_iter().collect()
+        };
         let mut line = format!("  {:<9} {:>5}/{} done", stage.name(), sp.done, sp.total);
-        if *stage == Stage::Reference && st.reference_merged {
+        if merged {
             line.push_str(", reference merged");
         } else if !sp.complete() {
-            let shards: Vec<String> = shards_of(p, n, sp.todo())
-                .iter()
-                .map(|s| s.to_string())
-                .collect();
+            let list: Vec<String> = rerun.iter().map(|s| s.to_string()).collect();
             line.push_str(&format!(
                 ", {} missing, {} bad; shards to rerun: {}",
                 sp.missing.len(),
                 sp.bad.len(),
-                shards.join(",")
+                list.join(",")
             ));
         }
-        println!("{line}");
-        let a = p.plan.assignment(n);
-        if !(*stage == Stage::Reference && st.reference_merged) {
+        lines.push(line);
+        if !merged {
             for &i in sp.missing.iter().take(10) {
-                println!("    missing: {} (shard {}/{n})", p.plan.units[i].name, a[i]);
+                lines.push(format!(
+                    "    missing: {} (shard {}/{n})",
+                    p.plan.units[i].name, a[i]
+                ));
             }
             if sp.missing.len() > 10 {
-                println!("    ... and {} more missing", sp.missing.len() - 10);
+                lines.push(format!(
+                    "    ... and {} more missing",
+                    sp.missing.len() - 10
+                ));
             }
             for (i, why) in &sp.bad {
-                println!("    bad: {why} (shard {}/{n})", a[*i]);
+                lines.push(format!("    bad: {why} (shard {}/{n})", a[*i]));
             }
         }
+        let unit = |i: usize| serde_json::json!({ "unit": p.plan.units[i].name, "shard": a[i] });
+        stages.push(serde_json::json!({
+            "stage": stage.name(),
+            "done": sp.done,
+            "total": sp.total,
+            "reference_merged": merged,
+            "missing": if merged { vec![] } else { sp.missing.iter().map(|&i| unit(i)).collect::<Vec<_>>() },
+            "bad": if merged { vec![] } else {
+                sp.bad.iter().map(|(i, why)| {
+                    let mut u = unit(*i);
+                    u["why"] = why.clone().into();
+                    u
+                }).collect::<Vec<_>>()
+            },
+            "shards_to_rerun": rerun,
+        }));
     }
-    println!(
+    lines.push(format!(
         "  results   {}",
         if st.merged {
             "merged"
         } else {
             "not merged (`directlab merge`)"
         }
+    ));
+    for l in &lines {
+        crate::experiment::events::say(l);
+    }
+    crate::experiment::events::emit(
+        "status",
+        serde_json::json!({
+            "experiment": name,
+            "plan": p.plan.id,
+            "shards": n,
+            "stages": stages,
+            "merged": st.merged,
+        }),
     );
     st
 }
@@ -149,10 +189,11 @@ pub(crate) fn incomplete(p: &Planned, stage: Stage, sp: &StageProgress) -> Strin
     if sp.total - sp.done > 3 {
         names.push("...".into());
     }
+    let a = p.plan.assignment(n);
     let bad = sp
         .bad
         .first()
-        .map(|(_, why)| format!("; {why}"))
+        .map(|(i, why)| format!("; {why} (shard {}/{n})", a[*i]))
         .unwrap_or_default();
     format!(
         "{}: the {} stage is not complete: {} of {} units missing or bad ({}){bad}; \

@@ -1,16 +1,20 @@
 //! One finished unit of a plan on disk: its metrics row and, for reference chunks and runs
 //! whose image the figures need, the per-pixel count, mean and M2 in f64 (EXR holds no f64).
 //! Written to a temporary name and renamed, so a unit file is whole or absent; the header
-//! names the plan and the unit, the trailer repeats the length, so a file cut short or
-//! copied from another plan is recognised without trusting its contents.
+//! names the plan and the unit, the trailer repeats the length and holds a checksum of
+//! everything before it, so a file cut short, copied from another plan or altered on disk
+//! (an edited row, a changed pixel, a film relabelled 4x16 instead of 8x8) is refused
+//! before any of it is trusted. Values are checked too ([`Accum::check_values`]).
 
+use crate::experiment::cache::Fnv;
 use crate::experiment::chunks::{put_bytes, Accum, Reader};
 use crate::experiment::results::Row;
-use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
-const MAGIC: &[u8; 8] = b"DLUNIT01";
+const MAGIC: &[u8; 8] = b"DLUNIT02";
 const END: &[u8; 8] = b"DLUNITOK";
+/// Length (8 bytes), checksum (8) and end marker (8).
+const TRAILER: usize = 24;
 
 /// What a unit produced.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,8 +55,10 @@ pub fn write(path: &Path, owner: Owner, r: &UnitResult) -> Result<(), String> {
         }
         None => b.push(0),
     }
-    let total = b.len() as u64 + 16;
+    let total = (b.len() + TRAILER) as u64;
     b.extend_from_slice(&total.to_le_bytes());
+    let sum = checksum(&b);
+    b.extend_from_slice(&sum.to_le_bytes());
     b.extend_from_slice(END);
     crate::output::write_atomic(path, |tmp| {
         std::fs::write(tmp, &b).map_err(|e| format!("{}: {e}", path.display()))
@@ -99,62 +105,43 @@ fn check_header(r: &mut Reader, owner: Owner) -> Result<(), String> {
     Ok(())
 }
 
-/// Checks the trailer: the file is as long as its writer said.
-fn check_trailer(tail: &[u8], len: u64) -> Result<(), String> {
-    let total = u64::from_le_bytes(tail[..8].try_into().expect("16 bytes"));
-    if &tail[8..] != END || total != len {
+/// FNV-1a of everything before the checksum.
+fn checksum(b: &[u8]) -> u64 {
+    Fnv::new().bytes(b).value()
+}
+
+/// Checks the trailer of the whole file `b`: as long as its writer said, and every byte before
+/// the checksum as it was written.
+fn check_trailer(b: &[u8]) -> Result<(), String> {
+    if b.len() < TRAILER {
+        return Err(format!("is truncated ({} bytes)", b.len()));
+    }
+    let tail = &b[b.len() - TRAILER..];
+    let total = u64::from_le_bytes(tail[..8].try_into().expect("8 bytes"));
+    if &tail[16..] != END || total != b.len() as u64 {
         return Err(format!(
-            "is truncated or damaged ({len} bytes; its end marker is missing or names another length)"
+            "is truncated or damaged ({} bytes; its end marker is missing or names another length)",
+            b.len()
         ));
     }
-    Ok(())
-}
-
-/// Whether `path` holds unit `owner` complete, reading only its header and trailer: Ok(false)
-/// if absent, Err(reason) if something else is there.
-pub fn is_done(path: &Path, owner: Owner) -> Result<bool, String> {
-    let mut f = match std::fs::File::open(path) {
-        Ok(f) => f,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(false),
-        Err(e) => return Err(format!("cannot be read: {e}")),
-    };
-    let len = f
-        .metadata()
-        .map_err(|e| format!("cannot be read: {e}"))?
-        .len();
-    let want = header(owner).len() as u64;
-    if len < want + 16 {
-        check_header(&mut Reader::new(&read_some(&mut f, len)?), owner)?;
-        return Err(format!("is truncated ({len} bytes)"));
+    let sum = u64::from_le_bytes(tail[8..16].try_into().expect("8 bytes"));
+    if sum != checksum(&b[..b.len() - 16]) {
+        return Err(
+            "is damaged: its contents do not match the checksum it was written with (edited or \
+             corrupted on disk); run its shard again"
+                .into(),
+        );
     }
-    check_header(&mut Reader::new(&read_some(&mut f, want)?), owner)?;
-    let mut tail = [0u8; 16];
-    f.seek(SeekFrom::End(-16))
-        .and_then(|_| f.read_exact(&mut tail))
-        .map_err(|e| format!("cannot be read: {e}"))?;
-    check_trailer(&tail, len)?;
-    Ok(true)
-}
-
-fn read_some(f: &mut std::fs::File, n: u64) -> Result<Vec<u8>, String> {
-    let mut b = Vec::new();
-    f.take(n)
-        .read_to_end(&mut b)
-        .map_err(|e| format!("cannot be read: {e}"))?;
-    Ok(b)
+    Ok(())
 }
 
 /// Reads unit `owner` from `path`; errors name the file and what is wrong with it.
 pub fn read(path: &Path, owner: Owner) -> Result<UnitResult, String> {
     let bad = |why: String| format!("{}: unit file {why}", path.display());
     let b = std::fs::read(path).map_err(|e| bad(format!("cannot be read: {e}")))?;
-    let mut r = Reader::new(&b);
-    check_header(&mut r, owner).map_err(bad)?;
-    if b.len() < 16 {
-        return Err(bad("is truncated".into()));
-    }
-    check_trailer(&b[b.len() - 16..], b.len() as u64).map_err(bad)?;
-    let mut r = Reader::new(&b[..b.len() - 16]);
+    check_header(&mut Reader::new(&b), owner).map_err(bad)?;
+    check_trailer(&b).map_err(bad)?;
+    let mut r = Reader::new(&b[..b.len() - TRAILER]);
     check_header(&mut r, owner).map_err(bad)?;
     let damaged = || bad("is damaged (its contents do not parse)".into());
     let row = r.bytes().ok_or_else(damaged)?;
@@ -170,6 +157,10 @@ pub fn read(path: &Path, owner: Owner) -> Result<UnitResult, String> {
     };
     if r.left() != 0 {
         return Err(damaged());
+    }
+    if let Some(a) = &accum {
+        a.check_values()
+            .map_err(|e| bad(format!("is damaged: {e}")))?;
     }
     Ok(UnitResult { row, accum })
 }
@@ -211,9 +202,7 @@ mod tests {
             accum: Some(acc),
         };
         let path = dir.join("00003.unit");
-        assert_eq!(is_done(&path, owner), Ok(false));
         write(&path, owner, &r).unwrap();
-        assert_eq!(is_done(&path, owner), Ok(true));
         let back = read(&path, owner).unwrap();
         let (mut a, mut b) = (back.clone(), r.clone());
         assert!(a.row.as_ref().unwrap().mean_z2.is_nan());
@@ -233,7 +222,6 @@ mod tests {
             e.contains("00003.unit") && e.contains("belongs to plan p1"),
             "{e}"
         );
-        assert!(is_done(&path, other_plan).unwrap_err().contains("plan p1"));
         let other_unit = Owner { index: 4, ..owner };
         assert!(read(&path, other_unit).unwrap_err().contains("not unit 4"));
 
@@ -245,8 +233,25 @@ mod tests {
                 e.contains("truncated") || e.contains("not a directlab"),
                 "{cut}: {e}"
             );
-            assert!(is_done(&path, owner).is_err(), "{cut}");
         }
+        // Altered on disk, one byte at a time, anywhere: refused by the checksum (or, in the
+        // header, as another unit's file).
+        for at in [20, bytes.len() / 2, bytes.len() - 30] {
+            let mut b = bytes.clone();
+            b[at] ^= 0x10;
+            std::fs::write(&path, &b).unwrap();
+            let e = read(&path, owner).unwrap_err();
+            assert!(
+                e.contains("checksum") || e.contains("holds unit"),
+                "{at}: {e}"
+            );
+        }
+        // A value no render gives, written with a valid checksum, is still refused.
+        let mut nan = r.clone();
+        nan.accum.as_mut().unwrap().mean[0][1] = f64::NAN;
+        write(&path, owner, &nan).unwrap();
+        let e = read(&path, owner).unwrap_err();
+        assert!(e.contains("pixel (0, 0)"), "{e}");
         std::fs::write(&path, "x,y\n1,2\n").unwrap();
         assert!(read(&path, owner)
             .unwrap_err()

@@ -92,6 +92,10 @@ pub struct Plan {
     pub units: Vec<Unit>,
     /// Hash of everything above but `shards`: names the plan in every unit file.
     pub id: String,
+    /// Hash of the id and `shards`: the shard count may change (`plan --shards`), but not by
+    /// an edit of the file.
+    #[serde(default)]
+    pub shards_id: String,
 }
 
 /// Hash of an experiment file's bytes and the quick flag.
@@ -165,6 +169,7 @@ impl Plan {
             shards: shards.max(1),
             units,
             id: String::new(),
+            shards_id: String::new(),
         };
         plan.id = plan.hash();
         Ok(plan)
@@ -179,6 +184,13 @@ impl Plan {
             .field(self.reference_key.as_bytes())
             .field(self.context.as_bytes())
             .field(units.as_bytes());
+        h.hex()
+    }
+
+    fn shards_hash(&self) -> String {
+        let mut h = Fnv::new();
+        h.field(self.id.as_bytes())
+            .field(&self.shards.to_le_bytes());
         h.hex()
     }
 
@@ -197,7 +209,9 @@ impl Plan {
     }
 
     pub fn save(&self, path: &Path) -> Result<(), String> {
-        let json = serde_json::to_string_pretty(self).map_err(|e| e.to_string())?;
+        let mut sealed = self.clone();
+        sealed.shards_id = self.shards_hash();
+        let json = serde_json::to_string_pretty(&sealed).map_err(|e| e.to_string())?;
         crate::output::write_atomic(path, |tmp| {
             std::fs::write(tmp, json + "\n").map_err(|e| format!("{}: {e}", path.display()))
         })
@@ -224,6 +238,16 @@ impl Plan {
                 plan.id
             ));
         }
+        crate::experiment::shard::shard_count(plan.shards as u64)
+            .map_err(|e| format!("{}: \"shards\": {e}", path.display()))?;
+        if plan.shards_id != plan.shards_hash() {
+            return Err(format!(
+                "{}: its \"shards\" ({}) was edited after the plan was made; change the count \
+                 with `directlab plan --shards N` (or run `directlab plan` again)",
+                path.display(),
+                plan.shards
+            ));
+        }
         Ok(Some(plan))
     }
 
@@ -238,6 +262,14 @@ impl Plan {
             format!(
                 "was made by directlab {} (plan format {}), this is {} (format {})",
                 self.directlab, self.format, current.directlab, current.format
+            )
+        } else if self.experiment_hash != current.experiment_hash
+            && self.experiment != current.experiment
+        {
+            format!(
+                "was made from the experiment file {}, not from {} (both write to this \
+                 folder; give one of them another --out)",
+                self.experiment, current.experiment
             )
         } else if self.experiment_hash != current.experiment_hash {
             format!(
@@ -315,6 +347,7 @@ mod tests {
             shards: 1,
             units,
             id: String::new(),
+            shards_id: String::new(),
         };
         p.id = p.hash();
         p
@@ -346,6 +379,25 @@ mod tests {
     }
 
     #[test]
+    fn an_edited_shard_count_is_refused_and_a_bounded_one_kept() {
+        let dir = std::env::temp_dir().join(format!("directlab-plan-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("plan.json");
+        let mut p = plan(vec![unit(Stage::Sweep, 4)]);
+        p.shards = 4;
+        p.save(&path).unwrap();
+        assert_eq!(Plan::load(&path).unwrap().unwrap().shards, 4);
+        let text = std::fs::read_to_string(&path).unwrap();
+        for (shards, want) in [("5", "was edited"), ("4294967295", "at most 100000")] {
+            let edited = text.replace("\"shards\": 4", &format!("\"shards\": {shards}"));
+            std::fs::write(&path, edited).unwrap();
+            let e = Plan::load(&path).unwrap_err();
+            assert!(e.contains("plan.json") && e.contains(want), "{e}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn a_changed_plan_is_named_by_what_changed() {
         let p = plan(vec![unit(Stage::Sweep, 4)]);
         let path = Path::new("out/e/plan.json");
@@ -355,6 +407,14 @@ mod tests {
         let e = other.check_matches(&p, path).unwrap_err();
         assert!(
             e.contains("out/e/plan.json") && e.contains("another version of e.toml"),
+            "{e}"
+        );
+        let mut other = p.clone();
+        other.experiment_hash = "h3".into();
+        other.experiment = "elsewhere/sh.toml".into();
+        let e = other.check_matches(&p, path).unwrap_err();
+        assert!(
+            e.contains("experiment file elsewhere/sh.toml, not from e.toml"),
             "{e}"
         );
         let mut other = p.clone();

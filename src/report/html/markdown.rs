@@ -82,7 +82,9 @@ fn figure(dest: &str, alt: &str, dir: &Path, figures: Figures, counts: &mut Coun
     if figures == Figures::Link {
         return linked(counts, dest);
     }
-    let svg = path.with_extension("svg");
+    // The report is written as one set: its figures may still be under their new names.
+    let svg = crate::output::pending(&path.with_extension("svg"));
+    let path = crate::output::pending(&path);
     if let Ok(text) = std::fs::read_to_string(&svg) {
         if let Some(at) = text.find("<svg") {
             counts.svgs += 1;

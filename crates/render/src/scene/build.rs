@@ -156,10 +156,24 @@ fn area_light(
             }
             let degenerate = areas.iter().filter(|a| **a == 0.0).count();
             let table = AliasTable::new(&areas).ok_or_else(|| {
-                err(
-                    o,
-                    "emitter mesh has zero total area (every triangle is degenerate)",
-                )
+                // Far from the origin, f32 cannot tell a mesh's vertices apart: a to_world
+                // that moves a light there leaves it no area, which is not the mesh's fault.
+                let far = m
+                    .positions
+                    .iter()
+                    .map(|p| p.abs().max_element())
+                    .fold(0.0f32, f32::max);
+                let why = if far > 1e6 {
+                    format!(
+                        "its vertices lie up to {far:e} from the origin, where single precision \
+                         spaces numbers {:e} apart, so its triangles collapse (check the \
+                         to_world transform; move the scene closer to the origin)",
+                        far * f32::EPSILON
+                    )
+                } else {
+                    "every triangle is degenerate".to_string()
+                };
+                err(o, format!("emitter mesh has zero total area: {why}"))
             })?;
             if degenerate > 0 {
                 warnings.push(format!(

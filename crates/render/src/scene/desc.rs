@@ -160,6 +160,12 @@ impl StrategyKind {
         bsdf_samples: u32,
     ) -> Result<Self, String> {
         use StrategyKind::*;
+        for (n, what) in [
+            (emitter_samples, "emitter_samples"),
+            (bsdf_samples, "bsdf_samples"),
+        ] {
+            crate::limits::count(n as u64, what, crate::limits::TECHNIQUE_SAMPLES)?;
+        }
         match (self, emitter_samples, bsdf_samples) {
             (_, 0, 0) => {
                 Err("emitter_samples and bsdf_samples are both 0: nothing would be sampled".into())

@@ -52,6 +52,8 @@ impl<'a> Plugin<'a> {
         elem.check_attrs(attrs)?;
         let ty = elem.required_attr("type")?.to_string();
         let mut props: Vec<Prop<'a>> = Vec::new();
+        // Name to index, so a plugin with many parameters is checked in linear time.
+        let mut seen: std::collections::HashMap<String, usize> = Default::default();
         let mut nested = Vec::new();
         for child in &elem.children {
             let tag = child.tag.as_str();
@@ -73,12 +75,13 @@ impl<'a> Plugin<'a> {
                 _ => &["name", "value"],
             })?;
             let name = normalize_name(child.required_attr("name")?);
-            if let Some(first) = props.iter().find(|p| p.name == name) {
+            if let Some(&first) = seen.get(&name) {
                 return Err(child.err(format!(
                     "parameter '{name}' is given twice (first on line {})",
-                    first.elem.line
+                    props[first].elem.line
                 )));
             }
+            seen.insert(name.clone(), props.len());
             props.push(Prop {
                 name,
                 elem: child,
@@ -158,6 +161,26 @@ impl<'a> Plugin<'a> {
             p.elem
                 .err(format!("expected a non-negative integer, found {v}"))
         })
+    }
+
+    /// The integer parameter `key`, if given, within `bound` ([`crate::limits`]): an error
+    /// names the element (file and line), the parameter and the limit.
+    pub fn bounded(
+        &self,
+        key: &'static str,
+        bound: crate::limits::Bound,
+    ) -> Result<Option<u32>, SceneError> {
+        let Some(v) = self.count(key)? else {
+            return Ok(None);
+        };
+        let p = self.get(key).expect("count found it");
+        crate::limits::count(
+            v as u64,
+            &format!("'{}'", p.elem.attr("name").unwrap_or(key)),
+            bound,
+        )
+        .map(|_| Some(v))
+        .map_err(|m| p.elem.err(m))
     }
 
     /// The boolean parameter `key`, if given.

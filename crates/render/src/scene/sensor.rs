@@ -10,6 +10,9 @@ use super::xml::{parse_float, Element};
 use crate::named::Named;
 use glam::Mat4;
 
+/// The widest reconstruction filter accepted, in pixels.
+pub const MAX_FILTER_RADIUS: f32 = 64.0;
+
 #[rustfmt::skip]
 const KNOWN_INTEGRATORS: &[&str] = &[
     "path", "volpath", "volpathmis", "prb", "prb_basic", "prbvolpath", "direct_projective",
@@ -116,8 +119,13 @@ impl<'a> Loader<'a> {
             );
         }
         let shading = p.count("shading_samples")?;
-        let emitter_samples = p.count("emitter_samples")?.or(shading).unwrap_or(1);
-        let bsdf_samples = p.count("bsdf_samples")?.or(shading).unwrap_or(1);
+        let samples = |key| p.bounded(key, crate::limits::TECHNIQUE_SAMPLES);
+        let shading = match shading {
+            Some(_) => samples("shading_samples")?,
+            None => None,
+        };
+        let emitter_samples = samples("emitter_samples")?.or(shading).unwrap_or(1);
+        let bsdf_samples = samples("bsdf_samples")?.or(shading).unwrap_or(1);
         let hide_emitters = p.boolean("hide_emitters")?.unwrap_or(false);
         if direct_part_of.is_some() {
             for key in ["max_depth", "rr_depth"] {
@@ -347,6 +355,15 @@ impl<'a> Loader<'a> {
             FilterDesc::Tent { radius } | FilterDesc::Gaussian { radius, .. } if radius <= 0.0 => {
                 Err(e.err("filter radius must be positive"))
             }
+            FilterDesc::Tent { radius } | FilterDesc::Gaussian { radius, .. }
+                if !(radius <= MAX_FILTER_RADIUS) =>
+            {
+                Err(e.err(format!(
+                    "filter radius {radius} pixels: at most {MAX_FILTER_RADIUS} is accepted (a \
+                     wider filter spreads every sample over the whole film, and its weights \
+                     underflow to a black image)"
+                )))
+            }
             FilterDesc::Gaussian { stddev, .. } if stddev <= 0.0 => {
                 Err(e.err("gaussian stddev must be positive"))
             }
@@ -357,7 +374,9 @@ impl<'a> Loader<'a> {
     pub(super) fn sampler(&mut self, e: &'a Element) -> Result<SamplerDesc, SceneError> {
         let p = Plugin::new(e, &["type", "id", "name"])?;
         let default_count = if self.is_nori() { 1 } else { 4 };
-        let sample_count = p.count("sample_count")?.unwrap_or(default_count);
+        let sample_count = p
+            .bounded("sample_count", crate::limits::SPP)?
+            .unwrap_or(default_count);
         let seed = p.count("seed")?.unwrap_or(0) as u64;
         use crate::sampler::SamplerKind;
         let names: Vec<&str> = SamplerKind::CHOICES.iter().map(|c| c.name).collect();
