@@ -99,6 +99,34 @@ fn counts_beyond_their_bounds_are_refused_naming_where_they_came_from() {
         &["sweep.toml", "spp is 4294967295", "at most 16777216"],
     );
 
+    let strategy = d.join("strategy.toml");
+    std::fs::write(
+        &strategy,
+        std::fs::read_to_string(&exp).unwrap().replace(
+            "strategy = \"light\"\nemitter_selection = \"power\"",
+            "strategy = \"light\"\nemitter_selection = \"power\"\nemitter_samples = 1000000000",
+        ),
+    )
+    .unwrap();
+    fails(
+        &mut cmd(&["run", p(&strategy), "--out", o]),
+        1,
+        &[
+            "strategy.toml",
+            "emitter_samples is 1000000000",
+            "at most 1024",
+        ],
+    );
+    // The many-light grid: one BSDF tested once, not once per material (9,220 cases).
+    let grid = repo("scenes/many-lights/grid.xml");
+    let o2 = within(&mut cmd(&["chi2", "--scene", p(&grid), "--list"]), 30);
+    let listed =
+        String::from_utf8_lossy(&o2.stdout).to_string() + &String::from_utf8_lossy(&o2.stderr);
+    assert!(o2.status.success(), "{listed}");
+    let cases = listed.lines().filter(|l| l.starts_with("scene/")).count();
+    assert!(cases <= 16, "{cases} cases: {listed}");
+    assert!(listed.contains("same BSDF and parameters"), "{listed}");
+
     // The integrands' seeds and largest N; --quick no longer overrides what is given.
     let i = d.join("i");
     for (args, words) in [

@@ -179,6 +179,26 @@ mod tests {
     }
 
     #[test]
+    fn a_cgroup_limit_is_what_it_leaves_and_no_limit_is_none() {
+        let d = std::env::temp_dir().join(format!("directlab-cgroup-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::write(d.join("memory.max"), "4294967296\n").unwrap();
+        std::fs::write(d.join("memory.current"), "1073741824\n").unwrap();
+        let l = cgroup_dir_limit(&d, "memory.max", "memory.current").unwrap();
+        assert_eq!(l.left, 3 << 30);
+        assert!(
+            l.what.contains("memory.max = 4.0 GiB") && l.what.contains("--mem"),
+            "{l:?}"
+        );
+        std::fs::write(d.join("memory.max"), "max\n").unwrap();
+        assert!(cgroup_dir_limit(&d, "memory.max", "memory.current").is_none());
+        // cgroup v1 spells "no limit" as a number near 2^63.
+        std::fs::write(d.join("memory.max"), "9223372036854771712\n").unwrap();
+        assert!(cgroup_dir_limit(&d, "memory.max", "memory.current").is_none());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
     fn this_process_has_a_limit_that_is_read() {
         let l = tightest().expect("/proc/meminfo is readable here");
         assert!(l.left > 0 && !l.what.is_empty(), "{l:?}");
