@@ -55,6 +55,10 @@ pub fn cases(
             "{repeats} material(s) with the same BSDF and parameters as one tested already"
         ));
     }
+    let has_sphere_light = scene
+        .shapes
+        .iter()
+        .any(|s| s.emitter.is_some() && matches!(s.kind, crate::geometry::ShapeKind::Sphere(_)));
     let triangles: usize = scene
         .shapes
         .iter()
@@ -106,15 +110,19 @@ pub fn cases(
             let sel = selection.name();
             let name = format!("scene/lights-{sel}-receiver{k}");
             let about = format!(
-                "the scene's lights chosen by {sel}, sampled from {} at pixel ({px}, {py})",
-                sp.p
+                "the scene's lights chosen by {sel}, sampled from {} (normal {}) at pixel \
+                 ({px}, {py})",
+                sp.p, sp.ns
             );
             let label = name.clone();
-            // On the whole sphere: a window fitted to the lights from a point on a surface
-            // near them (Veach's plates under its spheres) can miss the edge of a sphere's
+            // A window fitted to the lights' directions resolves a light seen edge-on (a
+            // sliver that the whole sphere's grid cannot: the ceiling light seen from just
+            // under the ceiling). Spheres stay on the whole sphere: a window fitted from a
+            // point near one (Veach's plates under its spheres) can miss the edge of its
             // silhouette, and a sample outside the window fails a correct sampler.
+            let window = !has_sphere_light;
             out.push(Case::new(name, about, move |cfg| {
-                run_probe(&label, &probe, cfg, false)
+                run_probe(&label, &probe, cfg, window)
             }));
         }
     }
