@@ -105,22 +105,28 @@ fn run_files(files: &[PathBuf], a: &SweepArgs) -> Result<(), String> {
             failed.push(f.display().to_string());
         }
     }
-    crate::report::write_root_index(&a.out)?;
+    // With nothing written, no index: it would be empty, and the run ends with the failure.
+    let wrote = failed.len() < files.len();
+    if wrote {
+        crate::report::write_root_index(&a.out)?;
+    }
     events::emit(
         "finished",
         serde_json::json!({
             "experiments": files.len(),
             "failed": failed,
             "seconds": start.elapsed().as_secs_f64(),
-            "index": a.out.join("index.md"),
+            "index": wrote.then(|| a.out.join("index.md")),
         }),
     );
-    eprintln!(
-        "{} experiment(s) in {:.1} s; reports in {}",
-        files.len(),
-        start.elapsed().as_secs_f64(),
-        a.out.join("index.md").display()
-    );
+    if wrote {
+        eprintln!(
+            "{} experiment(s) in {:.1} s; reports in {}",
+            files.len() - failed.len(),
+            start.elapsed().as_secs_f64(),
+            a.out.join("index.md").display()
+        );
+    }
     if failed.is_empty() {
         Ok(())
     } else {

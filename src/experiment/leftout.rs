@@ -96,11 +96,17 @@ fn effective(s: &Strategy, t: &SceneTraits) -> Result<(Strategy, Vec<String>), S
         e.selection = EmitterSelection::Power;
         why.push("ris:1 keeps its only candidate, drawn by power: power choice".into());
     }
+    if t.emitters == 1 && e.selection != EmitterSelection::Uniform {
+        // Every rule (power, the light tree, exhaustive, RIS) picks the only emitter with
+        // pmf 1: one estimator, whatever its name.
+        why.push(format!(
+            "with one emitter, {} and uniform choice pick it with pmf 1",
+            e.selection.name()
+        ));
+        e.selection = EmitterSelection::Uniform;
+    }
     if e.selection == EmitterSelection::Power {
-        if t.emitters == 1 {
-            e.selection = EmitterSelection::Uniform;
-            why.push("with one emitter, power and uniform choice pick it with pmf 1".into());
-        } else if t.equal_power {
+        if t.equal_power {
             e.selection = EmitterSelection::Uniform;
             why.push("all emitters have equal power, so the power pmf is uniform".into());
         }
@@ -191,6 +197,31 @@ mod tests {
         assert_eq!(names(&kept), ["uniform"]);
         assert_eq!(out[0].name, "power");
         assert!(out[0].reason.contains("one emitter"), "{}", out[0].reason);
+        // Every rule is one estimator with one emitter: kept once, the others named.
+        let mut every = list.clone();
+        for sel in [
+            EmitterSelection::Bvh,
+            EmitterSelection::Exhaustive,
+            EmitterSelection::Ris(8),
+        ] {
+            every.push((
+                sel.name(),
+                Strategy {
+                    selection: sel,
+                    ..uni
+                },
+            ));
+        }
+        let (kept, out) = leave_out(&every, &traits(1));
+        assert_eq!(names(&kept), ["uniform"]);
+        assert_eq!(out.len(), 4);
+        assert!(
+            out.iter()
+                .all(|o| o.reason.contains("identical to 'uniform'") && o.reason.contains("pmf 1")),
+            "{out:?}"
+        );
+        let (kept, _) = leave_out(&every, &traits(2));
+        assert_eq!(kept.len(), 5);
         let equal = SceneTraits {
             equal_power: true,
             ..traits(3)

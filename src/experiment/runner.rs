@@ -174,6 +174,10 @@ fn strategies(
             "{}: leaving out '{}' ({}): {}",
             exp.name, o.name, o.label, o.reason
         );
+        events::emit(
+            "left_out",
+            json!({ "experiment": exp.name, "strategy": o.name, "label": o.label, "reason": o.reason }),
+        );
     }
     Ok((cross(&kept, &exp.exp.samplers), omitted))
 }
@@ -309,6 +313,13 @@ impl Setup {
 pub(crate) fn setup(exp: Resolved, opts: &RunOptions) -> Result<Setup, String> {
     let dir = opts.out.join(&exp.name);
     let scene = crate::scene::open_with(exp.scene(), exp.defines(), exp.cases[0].integrator)?;
+    // The scene's warnings went to stderr as it loaded; under --json they are events too.
+    for w in &scene.warnings {
+        events::emit(
+            "warning",
+            json!({ "experiment": exp.name, "scene": exp.scene(), "message": w }),
+        );
+    }
     let base = Strategy::from_desc(&scene.desc.integrator);
     let (kept, omitted) = strategies(&exp, base, &scene)?;
 

@@ -215,8 +215,16 @@ fn metrics_that_would_switch_off_are_refused() {
         std::fs::write(&exp, text.replace(from, to)).unwrap();
         let mut words = words;
         words.push("tiny.toml");
-        fails(&mut cmd(&["run", p(&exp), "--out", p(&out)]), 1, &words);
+        let err = fails(&mut cmd(&["run", p(&exp), "--out", p(&out)]), 1, &words);
         assert!(!out.join("tiny/results.csv").exists());
+        // A run that wrote nothing ends with its failure, not with a reports line, and
+        // leaves no empty index.
+        assert!(!err.contains("reports in"), "{err}");
+        assert!(
+            err.trim_end().lines().last().unwrap().starts_with("error:"),
+            "{err}"
+        );
+        assert!(!out.join("index.md").exists());
     }
     std::fs::remove_dir_all(&d).unwrap();
 }

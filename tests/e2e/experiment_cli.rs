@@ -200,12 +200,38 @@ strategy = "light"
 name = "power"
 strategy = "light"
 emitter_selection = "power"
+[[strategy]]
+name = "tree"
+strategy = "light"
+emitter_selection = "bvh"
+[[strategy]]
+name = "oracle"
+strategy = "light"
+emitter_selection = "exhaustive"
 "#,
             scene.display().to_string().replace('\\', "/")
         ),
     )
     .unwrap();
     run_ok(&exp, &out);
+    // Again with --json: each strategy left out is an event with its reason.
+    let o = run(directlab()
+        .args(["run", exp.to_str().unwrap(), "--json", "--out"])
+        .arg(&out));
+    assert!(o.status.success());
+    let left: Vec<serde_json::Value> = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+        .filter(|v| v["event"] == "left_out")
+        .collect();
+    let names: Vec<&str> = left
+        .iter()
+        .map(|v| v["strategy"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["power", "tree", "oracle"], "{left:?}");
+    assert!(left
+        .iter()
+        .all(|v| v["reason"].as_str().unwrap().contains("pmf 1")));
     let index = std::fs::read_to_string(out.join("one-light/index.md")).unwrap();
     assert!(
         index.contains("**power** (`light-e1-pow-area`): identical to 'uniform'"),
