@@ -105,11 +105,9 @@ fn effective(s: &Strategy, t: &SceneTraits) -> Result<(Strategy, Vec<String>), S
         ));
         e.selection = EmitterSelection::Uniform;
     }
-    if e.selection == EmitterSelection::Power {
-        if t.equal_power {
-            e.selection = EmitterSelection::Uniform;
-            why.push("all emitters have equal power, so the power pmf is uniform".into());
-        }
+    if e.selection == EmitterSelection::Power && t.equal_power {
+        e.selection = EmitterSelection::Uniform;
+        why.push("all emitters have equal power, so the power pmf is uniform".into());
     }
     if t.all_lights_delta && e.light_sampling == LightSampling::SolidAngle {
         e.light_sampling = LightSampling::Area;
