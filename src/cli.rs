@@ -27,8 +27,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Run experiments (sweeps against a cached reference) and write their reports.
     Run(RunArgs),
-    /// Run the study's figures (experiments fig1, fig2, fig3), the samplers' (fig4) and
-    /// their test integrands, and write their reports.
+    /// Run the study's figures and this project's: fig1, fig2, fig3, fig4, fig4-veach, fig5,
+    /// fig5-cbox, fig5-tiles and the integrands report.
     Reproduce(ReproduceArgs),
     /// Split an experiment into fixed units (reference chunks, sweep runs, equal-time runs)
     /// for `run --shard I/N`; writes <out>/<name>/plan.json.
@@ -54,6 +54,9 @@ pub enum Command {
     /// The stability suite of extreme scenes (finiteness, bias and variance per strategy):
     /// short for `run experiments/extreme.toml`.
     Extreme(ExtremeArgs),
+    /// Print the grammar of strategy labels (`mis-pow-e1b1-pow-sa`, results.csv's `strategy`
+    /// column): every estimator's form and the short names of its settings.
+    Labels,
 }
 
 #[derive(Args, Debug)]
@@ -151,21 +154,31 @@ fn cmd_extreme(a: &ExtremeArgs) -> Result<(), String> {
     run_files(&[file], &a.sweep)
 }
 
+/// The experiments `reproduce` runs (experiments/<name>.toml), in order; the integrands report
+/// follows them.
+pub const REPRODUCE: &[&str] = &[
+    "fig1",
+    "fig2",
+    "fig3",
+    "fig4",
+    "fig4-veach",
+    "fig5",
+    "fig5-cbox",
+    "fig5-tiles",
+];
+
+/// What `reproduce` runs, in the words the README, `--help` and experiments/README.md use
+/// (a test keeps the three equal to this list).
+pub fn reproduce_statement() -> String {
+    format!("{} and the integrands report", REPRODUCE.join(", "))
+}
+
 fn cmd_reproduce(a: &ReproduceArgs) -> Result<(), String> {
     let dir = crate::experiment::experiments_dir()?;
-    let files: Vec<PathBuf> = [
-        "fig1",
-        "fig2",
-        "fig3",
-        "fig4",
-        "fig4-veach",
-        "fig5",
-        "fig5-cbox",
-        "fig5-tiles",
-    ]
-    .iter()
-    .map(|n| dir.join(format!("{n}.toml")))
-    .collect();
+    let files: Vec<PathBuf> = REPRODUCE
+        .iter()
+        .map(|n| dir.join(format!("{n}.toml")))
+        .collect();
     let integrands = crate::integrands::report::IntegrandsArgs {
         quick: a.sweep.quick,
         out: a.sweep.out.clone(),
@@ -183,13 +196,13 @@ pub struct RenderArgs {
     /// Scene file (XML).
     pub scene: PathBuf,
     /// Samples per pixel (default: the scene's sampler).
-    #[arg(long, value_parser = crate::limits::parse_spp)]
+    #[arg(long, short = 's', value_parser = crate::limits::parse_spp)]
     pub spp: Option<u32>,
     /// Seed (default: the scene's sampler seed).
     #[arg(long)]
     pub seed: Option<u64>,
     /// Worker threads (default: all cores). The image does not depend on it.
-    #[arg(long, value_parser = crate::render::parse_threads)]
+    #[arg(long, short = 't', value_parser = crate::render::parse_threads)]
     pub threads: Option<usize>,
     /// Sampler (default: the scene's <sampler type>, mapped to the nearest directlab one).
     #[arg(long, value_parser = named::<crate::sampler::SamplerKind>())]
@@ -200,7 +213,7 @@ pub struct RenderArgs {
     pub dims: crate::sampler::DimAlloc,
     /// Output EXR (default: <scene name>.exr in the current directory); a PNG preview is
     /// written beside it.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     pub out: Option<PathBuf>,
     /// Also write the per-pixel variance of the estimate (sample variance / spp) as EXR.
     #[arg(long)]
@@ -363,6 +376,10 @@ pub fn main() -> i32 {
                 .ok_or_else(|| "some sampling routines do not match their pdfs".to_string())
         }),
         Command::Extreme(a) => cmd_extreme(a),
+        Command::Labels => {
+            print!("{}", crate::labels::grammar());
+            Ok(())
+        }
         Command::Plan(a) => crate::pipeline::shard::cmd_plan(a),
         Command::Merge(a) => crate::pipeline::shard::cmd_merge(a),
         Command::Status(a) => crate::pipeline::shard::cmd_status(a),
@@ -377,6 +394,66 @@ pub fn main() -> i32 {
         Err(e) => {
             eprintln!("error: {e}");
             1
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Cli;
+    use clap::CommandFactory;
+
+    /// Every option and argument of every command says what it is for (`--help`), and no
+    /// command takes an option it ignores.
+    #[test]
+    fn every_option_has_help_and_commands_take_only_what_they_use() {
+        let cli = Cli::command();
+        let mut missing = Vec::new();
+        let mut todo: Vec<(String, &clap::Command)> = vec![("directlab".into(), &cli)];
+        while let Some((path, c)) = todo.pop() {
+            for a in c.get_arguments() {
+                let id = a.get_id().as_str();
+                if id == "help" || id == "version" {
+                    continue;
+                }
+                if a.get_help().is_none() && a.get_long_help().is_none() {
+                    missing.push(format!("{path} {id}"));
+                }
+            }
+            for s in c.get_subcommands() {
+                todo.push((format!("{path} {}", s.get_name()), s));
+            }
+        }
+        assert!(missing.is_empty(), "options without help: {missing:?}");
+        let takes = |cmd: &str, opt: &str| {
+            let c = cli.find_subcommand(cmd).expect("command");
+            c.get_arguments().any(|a| a.get_long() == Some(opt))
+        };
+        for (cmd, opt) in [
+            ("status", "viewer"),
+            ("status", "threads"),
+            ("plan", "fresh-reference"),
+            ("plan", "viewer"),
+            ("merge", "threads"),
+        ] {
+            assert!(!takes(cmd, opt), "`{cmd} --{opt}` is accepted and ignored");
+        }
+        let slurm = cli.find_subcommand("slurm").unwrap();
+        let submit = slurm.find_subcommand("submit").unwrap();
+        assert!(!submit
+            .get_arguments()
+            .any(|a| a.get_long() == Some("threads")));
+        for (cmd, short) in [
+            ("render", 'o'),
+            ("render", 't'),
+            ("render", 's'),
+            ("run", 'o'),
+        ] {
+            let c = cli.find_subcommand(cmd).unwrap();
+            assert!(
+                c.get_arguments().any(|a| a.get_short() == Some(short)),
+                "{cmd} -{short}"
+            );
         }
     }
 }

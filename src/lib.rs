@@ -19,6 +19,7 @@ pub mod cli;
 pub mod cost;
 pub mod experiment;
 pub mod integrands;
+pub mod labels;
 pub mod metrics;
 pub mod noritest;
 pub mod pipeline;

@@ -5,7 +5,7 @@
 //! pending forever). Submitted again, it sends only the shards that still own missing units.
 //! Slurm's own scheduler does the scheduling; directlab only writes and submits the scripts.
 
-use crate::experiment::args::{options, SweepArgs};
+use crate::experiment::args::{options, SelectArgs};
 use crate::experiment::events::{emit, say};
 use crate::experiment::shard::units::Stage;
 use crate::experiment::shard::{self, Planned, Status};
@@ -51,7 +51,7 @@ pub struct SubmitArgs {
     #[arg(long)]
     pub dry_run: bool,
     #[command(flatten)]
-    pub sweep: SweepArgs,
+    pub sweep: SelectArgs,
 }
 
 pub fn run(a: &SlurmArgs) -> Result<(), String> {
@@ -271,7 +271,7 @@ fn sbatch(script: &Path, after: Option<&str>) -> Result<String, String> {
 }
 
 fn submit(file: &Path, a: &SubmitArgs) -> Result<(), String> {
-    let opts = options(&a.sweep);
+    let opts = options(&a.sweep.sweep());
     let probe = shard::open(file, a.sweep.quick, &opts, false, None)?;
     let n = a.shards.unwrap_or(if probe.plan.shards > 1 {
         probe.plan.shards

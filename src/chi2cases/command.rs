@@ -26,6 +26,7 @@ pub struct Chi2Args {
     /// 3 to 2048 (2048 is 8.4 million cells a case, about 200 MB of tables per case run).
     #[arg(long, default_value_t = 51, value_parser = parse_resolution)]
     pub resolution: usize,
+    /// Seed of every case's random numbers (a run is reproducible from it).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Output directory for results.csv and the heat maps.

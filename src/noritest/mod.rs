@@ -30,6 +30,7 @@ pub struct TestArgs {
     /// Test every directlab strategy on every scene, also where the scene names one.
     #[arg(long)]
     pub all_strategies: bool,
+    /// Seed of the samplers and of the incident directions (a run is reproducible from it).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Where chi2test results (results.csv, heat maps) go: `<out>/<file stem>/`.

@@ -1,6 +1,6 @@
 //! The command line of sharded runs: `plan`, `run --shard`, `merge` and `status`.
 
-use crate::experiment::args::{options, SweepArgs};
+use crate::experiment::args::{options, ReportArgs, SelectArgs, SweepArgs};
 use crate::experiment::shard::units::Stage;
 use crate::experiment::shard::{self as shard, merge, run, status, ShardRef};
 use clap::Args;
@@ -29,7 +29,7 @@ pub struct PlanArgs {
     #[arg(long, default_value_t = 1, value_parser = shard::parse_shards)]
     pub shards: u32,
     #[command(flatten)]
-    pub sweep: SweepArgs,
+    pub select: SelectArgs,
 }
 
 #[derive(Args, Debug)]
@@ -41,7 +41,7 @@ pub struct MergeArgs {
     #[arg(long, value_enum)]
     pub stage: Option<Stage>,
     #[command(flatten)]
-    pub sweep: SweepArgs,
+    pub report: ReportArgs,
 }
 
 #[derive(Args, Debug)]
@@ -53,7 +53,7 @@ pub struct StatusArgs {
     #[arg(long, value_parser = shard::parse_shards)]
     pub shards: Option<u32>,
     #[command(flatten)]
-    pub sweep: SweepArgs,
+    pub select: SelectArgs,
 }
 
 /// Runs `f` on every file; one failing does not stop the others.
@@ -76,9 +76,10 @@ fn each(
 }
 
 pub fn cmd_plan(a: &PlanArgs) -> Result<(), String> {
-    let opts = options(&a.sweep);
+    let sweep = a.select.sweep();
+    let opts = options(&sweep);
     each(&a.experiments, |f| {
-        shard::make_plan(f, a.sweep.quick, &opts, a.shards)
+        shard::make_plan(f, sweep.quick, &opts, a.shards)
     })
 }
 
@@ -93,14 +94,15 @@ pub fn cmd_run_shard(
 }
 
 pub fn cmd_merge(a: &MergeArgs) -> Result<(), String> {
-    let opts = options(&a.sweep);
+    let sweep = a.report.sweep();
+    let opts = options(&sweep);
     each(&a.experiments, |f| {
         // Every unit is read and checked before anything is written; the images, results.csv
         // and the report then replace the old ones as one set.
-        let name = crate::experiment::load(f, a.sweep.quick)?.name;
-        let _lock = crate::experiment::lock::acquire(&a.sweep.out.join(name))?;
+        let name = crate::experiment::load(f, sweep.quick)?.name;
+        let _lock = crate::experiment::lock::acquire(&sweep.out.join(name))?;
         let merged = crate::output::as_one_set(|| {
-            let m = merge::merge(f, a.sweep.quick, &opts, a.stage)?;
+            let m = merge::merge(f, sweep.quick, &opts, a.stage)?;
             if let Some(m) = &m {
                 super::report_outcome(&m.outcome, opts.viewer)?;
             }
@@ -112,15 +114,16 @@ pub fn cmd_merge(a: &MergeArgs) -> Result<(), String> {
         Ok(())
     })?;
     if a.stage.is_none() {
-        crate::report::write_root_index(&a.sweep.out)?;
+        crate::report::write_root_index(&sweep.out)?;
     }
     Ok(())
 }
 
 pub fn cmd_status(a: &StatusArgs) -> Result<(), String> {
-    let opts = options(&a.sweep);
+    let sweep = a.select.sweep();
+    let opts = options(&sweep);
     each(&a.experiments, |f| {
-        let p = shard::open(f, a.sweep.quick, &opts, false, None)?;
+        let p = shard::open(f, sweep.quick, &opts, false, None)?;
         status::print_status(&p, a.shards);
         Ok(())
     })

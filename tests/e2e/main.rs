@@ -14,6 +14,7 @@ mod html_page;
 mod integrands_cli;
 mod layout;
 mod noritest_cli;
+mod quick_figures;
 mod readme;
 mod reference_cache;
 mod render_cli;

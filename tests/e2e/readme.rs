@@ -113,3 +113,33 @@ fn the_command_line_lists_and_checks_the_registered_values() {
         assert!(err.contains(says), "{option} {bad}: {err}");
     }
 }
+
+/// The example at the top of experiments/README.md runs as written (its scene path taken
+/// from the experiments folder), leaves nothing out and checks both strategies' means.
+#[test]
+fn the_first_example_of_the_experiment_guide_runs() {
+    let guide = std::fs::read_to_string(repo("experiments/README.md")).unwrap();
+    let start = guide.find("```toml\n").expect("a TOML example") + 8;
+    let toml = &guide[start..start + guide[start..].find("```").unwrap()];
+    assert!(toml.lines().count() <= 14, "a short example: {toml}");
+    let out = crate::common::scratch("guide-example");
+    let exp = out.join("example.toml");
+    let scene = repo("scenes/cbox/cbox.xml");
+    std::fs::write(
+        &exp,
+        toml.replace("../scenes/cbox/cbox.xml", scene.to_str().unwrap()),
+    )
+    .unwrap();
+    let o = crate::common::run(
+        crate::common::directlab()
+            .args(["run", exp.to_str().unwrap(), "--out"])
+            .arg(&out),
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(!err.contains("leaving out"), "{err}");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(stdout.matches("same expectation, ").count(), 2, "{stdout}");
+    assert!(out.join("example/index.html").is_file());
+    std::fs::remove_dir_all(&out).unwrap();
+}
