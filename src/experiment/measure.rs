@@ -143,9 +143,17 @@ pub(crate) fn measure(
         mape_eps: extra.mape_eps,
         exposure: extra.exposure,
     };
+    let mut not_applicable = Vec::new();
     for d in extra.chosen() {
-        (d.set)(&mut row, (d.compute)(&inputs));
+        let v = (d.compute)(&inputs);
+        if v.is_none() {
+            let why = super::metric::not_applicable(d.metric, out.mean.width, out.mean.height)
+                .unwrap_or("not defined for this image");
+            not_applicable.push(format!("{}: {why}", d.slug));
+        }
+        (d.set)(&mut row, v);
     }
+    row.not_applicable = not_applicable.join("; ");
     row.set_counts(&out.counts);
     row
 }

@@ -246,8 +246,18 @@ struct MetricRow<'a> {
     /// "linear" or the display transform SSIM and FLIP compare.
     tone_mapping: String,
     /// MSE and relMSE as measured (not corrected for the reference's noise; results.csv has
-    /// both).
-    value: f64,
+    /// both); empty where the metric does not apply to the run.
+    value: Option<f64>,
+    /// Why the value is empty ("" when there is one).
+    note: String,
+}
+
+/// Why metric `m` does not apply to a `w` x `h` film, if it does not (the metric's own rule).
+pub fn not_applicable(m: ErrorMetric, w: u32, h: u32) -> Option<&'static str> {
+    match m {
+        ErrorMetric::Ssim => crate::metrics::ssim::not_applicable(w as usize, h as usize),
+        _ => None,
+    }
 }
 
 /// `metrics.csv`: every run's every measured metric, one per row, each row naming the
@@ -284,7 +294,16 @@ pub fn write_long(path: &Path, rows: &[Row]) -> Result<(), String> {
                 values.push((d.metric, (d.value)(r), epsilon, tone));
             }
             for (m, v, epsilon, tone_mapping) in values {
-                let Some(value) = v else { continue };
+                let note = r
+                    .not_applicable
+                    .split("; ")
+                    .find_map(|n| n.strip_prefix(m.slug()).and_then(|x| x.strip_prefix(": ")));
+                let (value, note) = match (v, note) {
+                    (Some(x), _) if x.is_finite() => (Some(x), String::new()),
+                    (Some(_), _) => (None, "not a finite number".to_string()),
+                    (None, Some(why)) => (None, why.to_string()),
+                    (None, None) => continue,
+                };
                 w.serialize(MetricRow {
                     case: &r.case,
                     strategy: &r.strategy,
@@ -297,6 +316,7 @@ pub fn write_long(path: &Path, rows: &[Row]) -> Result<(), String> {
                     epsilon,
                     tone_mapping,
                     value,
+                    note,
                 })
                 .map_err(|e| e.to_string())?;
             }

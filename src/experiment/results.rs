@@ -69,6 +69,10 @@ pub struct Row {
     /// pixels (empty in rows written before it was recorded).
     #[serde(default)]
     pub top_share: Option<f64>,
+    /// The chosen metrics that do not apply to this run, each with the reason ("ssim: the
+    /// film is smaller than SSIM's 11x11 window"); their values are empty, never NaN.
+    #[serde(default)]
+    pub not_applicable: String,
     /// The metrics `[metrics] report` chooses (empty when not chosen): relMSE without its
     /// largest 0.1 % of terms (epsilon `relmse_eps`), ...
     #[serde(default)]
@@ -219,7 +223,9 @@ impl Results {
     /// partial last line, which `load` drops like any unreadable row (it is rendered again).
     pub fn push_and_append(&mut self, row: Row, path: &Path) -> Result<(), String> {
         let empty = std::fs::metadata(path).map_or(true, |m| m.len() == 0);
-        if empty {
+        // A file written by a build whose rows had other columns is written again whole:
+        // appended lines would not match its header.
+        if empty || !header_matches(path, &row) {
             return self.push_and_save(row, path);
         }
         let file = std::fs::OpenOptions::new()
@@ -245,6 +251,30 @@ impl Results {
             w.flush().map_err(|e| e.to_string())
         })
     }
+}
+
+/// Whether the first line of `path` is the header `row`'s columns make.
+fn header_matches(path: &Path, row: &Row) -> bool {
+    use std::io::BufRead;
+    let mut w = csv::Writer::from_writer(Vec::new());
+    if w.serialize(row).is_err() {
+        return false;
+    }
+    let Ok(bytes) = w.into_inner() else {
+        return false;
+    };
+    let want = bytes.split(|&b| b == b'\n').next().unwrap_or_default();
+    let Ok(f) = std::fs::File::open(path) else {
+        return false;
+    };
+    let mut first = Vec::new();
+    if std::io::BufReader::new(f)
+        .read_until(b'\n', &mut first)
+        .is_err()
+    {
+        return false;
+    }
+    first.strip_suffix(b"\n").unwrap_or(&first) == want
 }
 
 #[cfg(test)]
@@ -355,7 +385,45 @@ mod tests {
         cut.push_str(&line[..line.len() / 2]);
         std::fs::write(&path, cut).unwrap();
         let back = Results::load(&path, "ctx").unwrap();
-        assert_eq!((back.rows, back.dropped), (rows, 1));
+        assert_eq!((back.rows, back.dropped), (rows.clone(), 1));
+        // A file from a build with fewer columns: the next row rewrites it whole, so every
+        // line matches the header.
+        back_to_old_header(&path, &rows);
+        let mut res = Results::load(&path, "ctx").unwrap();
+        res.push_and_append(test_row("light", 4, 9), &path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let columns = |l: &str| {
+            csv::ReaderBuilder::new()
+                .has_headers(false)
+                .from_reader(l.as_bytes())
+                .records()
+                .next()
+                .unwrap()
+                .unwrap()
+                .len()
+        };
+        let n = columns(text.lines().next().unwrap());
+        assert!(text.lines().all(|l| columns(l) == n), "{text}");
+        assert!(
+            text.lines().next().unwrap().ends_with(",choice_evals"),
+            "{text}"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// `rows` as a build without the last column wrote them.
+    fn back_to_old_header(path: &Path, rows: &[Row]) {
+        Results {
+            rows: rows.to_vec(),
+            dropped: 0,
+        }
+        .save(path)
+        .unwrap();
+        let text = std::fs::read_to_string(path).unwrap();
+        let old: String = text
+            .lines()
+            .map(|l| format!("{}\n", &l[..l.rfind(',').unwrap()]))
+            .collect();
+        std::fs::write(path, old).unwrap();
     }
 }

@@ -70,12 +70,17 @@ fn channel(a: &[f64], b: &[f64], w: usize, h: usize) -> f64 {
     sum / mx.len() as f64
 }
 
+/// Why SSIM does not apply to a `w` x `h` image, if it does not.
+pub fn not_applicable(w: usize, h: usize) -> Option<&'static str> {
+    (w <= 2 * RADIUS || h <= 2 * RADIUS).then_some("the film is smaller than SSIM's 11x11 window")
+}
+
 /// Mean SSIM of two RGB images of tone-mapped values in [0, 1]; None if the image is smaller
 /// than the 11x11 window.
 pub fn ssim(a: &[[f64; 3]], b: &[[f64; 3]], w: usize, h: usize) -> Option<f64> {
     assert_eq!(a.len(), w * h);
     assert_eq!(b.len(), w * h);
-    if w <= 2 * RADIUS || h <= 2 * RADIUS {
+    if not_applicable(w, h).is_some() {
         return None;
     }
     let plane = |img: &[[f64; 3]], c: usize| -> Vec<f64> { img.iter().map(|p| p[c]).collect() };

@@ -216,6 +216,17 @@ pub(super) fn means(md: &mut String, o: &Outcome) {
         );
     }
     md.push('\n');
+    let (w, h) = (o.reference.mean.width, o.reference.mean.height);
+    let pixels = w as usize * h as usize;
+    if pixels < crate::stats::MIN_TAIL_TERMS {
+        let _ = writeln!(
+            md,
+            "On this {w}x{h} film ({pixels} pixels, fewer than {}) the tail rule does not \
+             apply: its 0.1 % of the pixels would be all the error, so a failed test is \
+             reported as a bias.\n",
+            crate::stats::MIN_TAIL_TERMS
+        );
+    }
     for l in mean_check_detail_lines(o) {
         let _ = writeln!(md, "- {l}");
     }

@@ -21,12 +21,18 @@ pub use welford::Welford;
 /// most likely missed a rare large value rather than being biased.
 pub const TAIL_SHARE: f64 = 0.5;
 
-/// Share of the sum of non-negative terms (squared errors) carried by its largest ceil(0.1 %):
+/// The fewest terms (pixels, samples) the tail rule reads: below it the largest 0.1 % is one
+/// term that is more than 0.1 % of them (on a 1x1 film, all of it), so the rule would fire
+/// on any error, a bias included.
+pub const MIN_TAIL_TERMS: usize = 1000;
+
+/// Share of the sum of non-negative terms (squared errors) carried by its largest 0.1 %:
 /// near 1 when a handful of outliers (fireflies, a tiny bright light) hold the error, which
-/// is when a sample variance underestimates the true one. NaN if all terms are 0.
+/// is when a sample variance underestimates the true one. NaN if all terms are 0, or if there
+/// are fewer than [`MIN_TAIL_TERMS`] (the rule does not apply).
 pub fn top_share(mut e: Vec<f64>) -> f64 {
     let total: f64 = e.iter().sum();
-    if !(total > 0.0) {
+    if !(total > 0.0) || e.len() < MIN_TAIL_TERMS {
         return f64::NAN;
     }
     let k = e.len().div_ceil(1000).max(1);
