@@ -44,6 +44,7 @@ pub fn discrete_test(
     };
     let mut r = Chi2Result {
         domain: "indices",
+        axes: ["index", ""],
         statistic: f64::NAN,
         dof: 0,
         p_value: 0.0,

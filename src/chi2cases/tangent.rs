@@ -126,6 +126,10 @@ impl Domain for Tangent {
         "tangent-plane window"
     }
 
+    fn axes(&self) -> [&'static str; 2] {
+        ["s (tangent plane, long axis)", "t (short axis)"]
+    }
+
     fn resolution(&self) -> (usize, usize) {
         (self.cols, self.rows)
     }

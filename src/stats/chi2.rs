@@ -80,6 +80,8 @@ impl Grid {
 #[derive(Clone, Debug)]
 pub struct Chi2Result {
     pub domain: &'static str,
+    /// What the grid's columns and rows are ([`Domain::axes`]).
+    pub axes: [&'static str; 2],
     pub statistic: f64,
     pub dof: usize,
     pub p_value: f64,
@@ -340,6 +342,7 @@ pub fn chi2_test<D: Domain>(
 
     let mut result = Chi2Result {
         domain: domain.name(),
+        axes: domain.axes(),
         statistic: f64::NAN,
         dof: 0,
         p_value: 0.0,

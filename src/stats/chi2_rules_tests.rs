@@ -32,6 +32,7 @@ fn result(observed: &[f64], expected: &[f64], lost: u64, pdf_integral: f64) -> C
     let n = observed.len();
     Chi2Result {
         domain: "test",
+        axes: ["u", "v"],
         statistic: 0.0,
         dof: 0,
         p_value: 1.0,

@@ -18,6 +18,10 @@ pub trait Domain {
     type Point: Copy;
     /// Short name for reports.
     fn name(&self) -> &'static str;
+    /// What u (columns, left to right) and v (rows, bottom to top) are, for heat maps.
+    fn axes(&self) -> [&'static str; 2] {
+        ["u", "v"]
+    }
     /// Grid size `(cols, rows)`: cols along u, rows along v.
     fn resolution(&self) -> (usize, usize);
     /// Parameter rectangle `([u0, u1], [v0, v1])`.
@@ -83,6 +87,9 @@ impl Domain for Sphere {
     fn name(&self) -> &'static str {
         "sphere"
     }
+    fn axes(&self) -> [&'static str; 2] {
+        ["phi 0..2pi", "cos theta -1..1"]
+    }
     fn resolution(&self) -> (usize, usize) {
         (self.n_phi, self.n_cos)
     }
@@ -130,6 +137,9 @@ impl Domain for UnitSquare {
     fn name(&self) -> &'static str {
         "unit square"
     }
+    fn axes(&self) -> [&'static str; 2] {
+        ["x 0..1", "y 0..1"]
+    }
     fn resolution(&self) -> (usize, usize) {
         (self.n, self.n)
     }
@@ -175,6 +185,9 @@ impl Domain for Disk {
     fn name(&self) -> &'static str {
         "unit disk"
     }
+    fn axes(&self) -> [&'static str; 2] {
+        ["phi 0..2pi", "r^2 0..1"]
+    }
     fn resolution(&self) -> (usize, usize) {
         (self.n_phi, self.n_r2)
     }
@@ -218,6 +231,9 @@ impl Domain for Triangle {
     type Point = Vec2;
     fn name(&self) -> &'static str {
         "unit triangle"
+    }
+    fn axes(&self) -> [&'static str; 2] {
+        ["x 0..1", "y 0..1 (x + y <= 1)"]
     }
     fn resolution(&self) -> (usize, usize) {
         (self.n, self.n)

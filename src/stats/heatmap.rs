@@ -1,4 +1,5 @@
-//! PNG of a chi-square run: observed | expected | standardised residual, side by side.
+//! PNG of a chi-square run: observed | expected | standardised residual, side by side, with
+//! titles, axes and colour bars.
 //!
 //! Observed and expected share one colour scale so a mismatch shows as a visible difference;
 //! the residual (obs - exp) / sqrt(exp) is roughly N(0, 1) per cell under the null, so a
@@ -6,7 +7,7 @@
 //! against noise. The v parameter (cos theta, y, r^2) increases upwards.
 
 use super::chi2::{Chi2Result, Grid};
-use image::{ImageFormat, Rgb, RgbImage};
+use image::{Rgb, RgbImage};
 use std::path::Path;
 
 /// Pixels between panels.
@@ -96,14 +97,84 @@ pub fn render(observed: &Grid, expected: &Grid, cell_px: u32) -> RgbImage {
     img
 }
 
-/// Writes [`render`] of a run to `path` as PNG, through [`crate::output::write_atomic`] so
-/// readers never see a half-written file.
+/// The three panels of [`render`] cut apart, each `(w, h, rgb)`.
+fn split(img: &RgbImage, cols: u32, cell_px: u32) -> Vec<(u32, u32, Vec<u8>)> {
+    let pw = cols * cell_px.max(1);
+    (0..3)
+        .map(|k| {
+            let x0 = k * (pw + GAP);
+            let rgb = (0..img.height())
+                .flat_map(|y| (x0..x0 + pw).flat_map(move |x| img.get_pixel(x, y).0))
+                .collect();
+            (pw, img.height(), rgb)
+        })
+        .collect()
+}
+
+/// A horizontal colour bar `w` pixels wide.
+fn bar(w: u32, colour: impl Fn(f64) -> Rgb<u8>) -> (u32, u32, Vec<u8>) {
+    const H: u32 = 12;
+    let row: Vec<u8> = (0..w)
+        .flat_map(|x| colour(x as f64 / (w.max(2) - 1) as f64).0)
+        .collect();
+    (w, H, row.repeat(H as usize))
+}
+
+/// Writes a run's heat maps to `path` as a PNG figure: observed, expected and residual
+/// panels with titles, their axes in the domain's coordinates ([`Chi2Result::axes`]) and
+/// colour bars with their numbers, through [`crate::output::write_atomic`].
 pub fn write(path: &Path, result: &Chi2Result, cell_px: u32) -> Result<(), String> {
+    use crate::plot::panels::{write_figure, Panel};
     let img = render(&result.observed, &result.expected, cell_px);
-    crate::output::write_atomic(path, |tmp| {
-        img.save_with_format(tmp, ImageFormat::Png)
-            .map_err(|e| format!("{}: cannot write PNG: {e}", path.display()))
-    })
+    let cols = result.observed.cols as u32;
+    let [u, v] = result.axes;
+    let axes = if v.is_empty() {
+        format!("across {u}")
+    } else {
+        format!("across {u}, up {v}")
+    };
+    let titles = [
+        "observed samples per cell",
+        "expected: N x pdf integral",
+        "residual (obs - exp) / sqrt(exp)",
+    ];
+    let panels: Vec<Panel> = split(&img, cols, cell_px)
+        .into_iter()
+        .zip(titles)
+        .map(|((w, h, rgb), t)| {
+            let mut p = Panel::new(t, w, h, rgb);
+            p.caption = axes.clone();
+            p
+        })
+        .collect();
+    let peak = result
+        .observed
+        .data
+        .iter()
+        .chain(&result.expected.data)
+        .fold(0.0f64, |m, &x| m.max(x));
+    let pw = cols * cell_px.max(1);
+    let (w, h, rgb) = bar(pw, sequential);
+    let mut counts = Panel::new(format!("0 to {peak:.0} samples per cell"), w, h, rgb);
+    counts.caption = "observed and expected share this scale".into();
+    let (w, h, rgb) = bar(pw, |t| diverging(2.0 * t - 1.0));
+    let mut resid = Panel::new(
+        format!("-{RESIDUAL_CLAMP} to +{RESIDUAL_CLAMP} (clamped); grey: impossible and empty"),
+        w,
+        h,
+        rgb,
+    );
+    resid.caption = "about N(0, 1) per cell when the sampler is right".into();
+    let title = format!(
+        "{} on the {}: chi2 = {:.2} on {} dof, p = {:.3e}, pdf integral {:.6}",
+        if result.passed() { "pass" } else { "FAIL" },
+        result.domain,
+        result.statistic,
+        result.dof,
+        result.p_value,
+        result.pdf_integral
+    );
+    write_figure(path, &title, &[panels, vec![counts, resid]])
 }
 
 #[cfg(test)]
@@ -142,15 +213,36 @@ mod tests {
         let path = dir.join("chi2.png");
         write(&path, &r, 6).unwrap();
         let img = image::open(&path).unwrap().to_rgb8();
-        assert_eq!(img.dimensions(), (3 * 11 * 6 + 2 * GAP, 21 * 6));
+        // Three panels, their titles and axes above and below, and a row of colour bars.
+        assert!(
+            img.width() > 3 * 11 * 6 && img.height() > 21 * 6 + 12,
+            "{:?}",
+            img.dimensions()
+        );
         assert_eq!(
             std::fs::read_dir(&dir).unwrap().count(),
             1,
             "a temporary file was left"
         );
-        // Lower hemisphere: samples where the pdf is 0 are drawn saturated red.
+        let count = |c: Rgb<u8>| img.pixels().filter(|p| **p == c).count();
+        // Lower hemisphere: samples where the pdf is 0 are drawn saturated red, in the residual
+        // panel (a cell of 36 pixels at least) and at the bar's end.
+        assert!(count(diverging(1.0)) >= 36, "no saturated residual cell");
+        assert!(
+            count(sequential(1.0)) >= 1 && count(diverging(-1.0)) >= 1,
+            "no colour bars"
+        );
+        // Text: dark pixels in the title line (white background).
+        let dark = (0..img.width())
+            .flat_map(|x| (0..20).map(move |y| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&c| c < 100))
+            .count();
+        assert!(dark > 50, "no title drawn ({dark} dark pixels)");
+        // The layout of the panels themselves.
+        let panels = render(&r.observed, &r.expected, 6);
+        assert_eq!(panels.dimensions(), (3 * 11 * 6 + 2 * GAP, 21 * 6));
         assert_eq!(
-            *img.get_pixel(2 * (66 + GAP) + 3, 21 * 6 - 3),
+            *panels.get_pixel(2 * (66 + GAP) + 3, 21 * 6 - 3),
             diverging(1.0)
         );
         std::fs::remove_dir_all(&dir).unwrap();
