@@ -399,9 +399,54 @@ pub fn chi2_test<D: Domain>(
         result.verdict = Verdict::Pass;
         result.reason = summary;
     } else {
-        result.reason = format!("rejected: sample histogram does not match the pdf ({summary})");
+        result.reason = format!(
+            "rejected: sample histogram does not match the pdf ({summary}); {}; {}",
+            integral_or_shape(pdf_integral, n, lost),
+            worst_cells(&result, cfg.min_expected)
+        );
     }
     result
+}
+
+/// Which part failed: the pdf's integral against the share of samples that landed, or the
+/// histogram's shape with the integral right.
+fn integral_or_shape(pdf_integral: f64, n: u64, lost: u64) -> String {
+    let landed = (n - lost.min(n)) as f64 / n.max(1) as f64;
+    if (pdf_integral - landed).abs() > 0.01 * landed.max(1e-12) {
+        format!(
+            "the pdf integrates to {pdf_integral:.4} over the grid but {landed:.4} of the samples \
+             landed: the integral failed (a wrong pdf, or mass the grid does not resolve)"
+        )
+    } else {
+        "the pdf's integral matches the samples: the histogram's shape failed".to_string()
+    }
+}
+
+/// The three cells that add most to the statistic, with their counts.
+fn worst_cells(r: &Chi2Result, min_expected: f64) -> String {
+    let cols = r.observed.cols;
+    let mut cells: Vec<(usize, f64, f64, f64)> = r
+        .observed
+        .data
+        .iter()
+        .zip(&r.expected.data)
+        .enumerate()
+        .filter(|(_, (_, &e))| e >= min_expected)
+        .map(|(i, (&o, &e))| (i, o, e, (o - e) * (o - e) / e))
+        .collect();
+    cells.sort_by(|a, b| b.3.total_cmp(&a.3));
+    let list: Vec<String> = cells
+        .iter()
+        .take(3)
+        .map(|&(i, o, e, c)| {
+            format!(
+                "(col {}, row {}) {o:.0} observed vs {e:.1} expected, {c:.1} of the statistic",
+                i % cols,
+                i / cols
+            )
+        })
+        .collect();
+    format!("worst cells: {}", list.join("; "))
 }
 
 #[cfg(test)]

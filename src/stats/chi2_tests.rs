@@ -61,6 +61,35 @@ fn cap_pdf(d: Vec3) -> f64 {
     }
 }
 
+/// A failure says which part failed and where: a pdf of the wrong shape (2x, integral 1)
+/// fails the histogram at the cells nearest x = 0 and x = 1; a pdf of the right shape but
+/// the wrong integral (0.8) fails the integral. alpha = 0.01, N = 200k.
+#[test]
+fn a_failure_names_the_part_that_failed_and_the_worst_cells() {
+    let r = chi2_test(
+        &square(),
+        |g| Some(g.next_2d()),
+        |p| 2.0 * p.x as f64,
+        &cfg(0.01),
+    );
+    assert!(!r.passed());
+    assert!(
+        r.reason.contains("the histogram's shape failed"),
+        "{}",
+        r.reason
+    );
+    let worst = &r.reason[r.reason.find("worst cells: (col ").expect("worst cells")..];
+    let col: usize = worst[18..worst.find(',').unwrap()].parse().unwrap();
+    assert!(col <= 1 || col >= 29, "{worst}");
+    let r = chi2_test(&square(), |g| Some(g.next_2d()), |_| 0.8, &cfg(0.01));
+    assert!(!r.passed());
+    assert!(
+        r.reason.contains("integrates to 0.8000") && r.reason.contains("the integral failed"),
+        "{}",
+        r.reason
+    );
+}
+
 #[test]
 fn uniform_square_passes() {
     // alpha = 0.01, N = 200k, 31x31 cells.
