@@ -16,6 +16,20 @@ fn table<T: Named>(md: &mut String, title: &str) {
     }
 }
 
+/// The configuration the examples show: 2 light and 3 BSDF samples, the power heuristic,
+/// emitter choice by power, solid-angle sampling.
+fn example(kind: StrategyKind) -> Strategy {
+    Strategy {
+        kind,
+        heuristic: Heuristic::Power,
+        emitter_samples: 2,
+        bsdf_samples: 3,
+        selection: EmitterSelection::Power,
+        light_sampling: LightSampling::SolidAngle,
+        hide_emitters: false,
+    }
+}
+
 /// The grammar, with an example of every estimator's label.
 pub fn grammar() -> String {
     let mut md = String::from(
@@ -23,21 +37,8 @@ pub fn grammar() -> String {
          column), in resume keys and in image file names. A label is the estimator's short \
          name followed by the settings that estimator reads, joined by '-':\n\n",
     );
-    let example = Strategy {
-        kind: StrategyKind::Light,
-        heuristic: Heuristic::Power,
-        emitter_samples: 2,
-        bsdf_samples: 3,
-        selection: EmitterSelection::Power,
-        light_sampling: LightSampling::SolidAngle,
-        hide_emitters: false,
-    };
     for c in StrategyKind::CHOICES {
-        let s = Strategy {
-            kind: c.value,
-            ..example
-        };
-        let _ = writeln!(md, "  {:<22} {}", s.label(), c.help);
+        let _ = writeln!(md, "  {:<22} {}", example(c.value).label(), c.help);
     }
     let _ = writeln!(
         md,
@@ -78,15 +79,7 @@ mod tests {
         for c in LightSampling::CHOICES {
             assert!(g.contains(c.value.short()), "{g}");
         }
-        let mis = Strategy {
-            kind: StrategyKind::Mis,
-            heuristic: Heuristic::Power,
-            emitter_samples: 2,
-            bsdf_samples: 3,
-            selection: EmitterSelection::Power,
-            light_sampling: LightSampling::SolidAngle,
-            hide_emitters: false,
-        };
+        let mis = example(StrategyKind::Mis);
         assert!(g.contains(&mis.label()), "{g}");
     }
 }
