@@ -54,7 +54,7 @@ pub enum Command {
     /// The stability suite of extreme scenes (finiteness, bias and variance per strategy):
     /// short for `run experiments/extreme.toml`.
     Extreme(ExtremeArgs),
-    /// Print the grammar of strategy labels (`mis-pow-e1b1-pow-sa`, results.csv's `strategy`
+    /// Print the grammar of strategy labels (`mis-power-e1b1-pow-sa`, results.csv's `strategy`
     /// column): every estimator's form and the short names of its settings.
     Labels,
 }

@@ -1,4 +1,4 @@
-//! The grammar of strategy labels (`mis-pow-e1b1-pow-sa`): what each part means, generated
+//! The grammar of strategy labels (`mis-power-e1b1-pow-sa`): what each part means, generated
 //! from the registries and from `Strategy::label` itself, so it cannot drift from the labels
 //! written to results.csv. `directlab labels` prints it; the README points to it.
 

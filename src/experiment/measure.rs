@@ -147,7 +147,7 @@ pub(crate) fn measure(
     for d in extra.chosen() {
         let v = (d.compute)(&inputs);
         if v.is_none() {
-            let why = super::metric::not_applicable(d.metric, out.mean.width, out.mean.height)
+            let why = (d.not_applicable)(out.mean.width, out.mean.height)
                 .unwrap_or("not defined for this image");
             not_applicable.push(format!("{}: {why}", d.slug));
         }

@@ -47,13 +47,18 @@ pub struct MetricDef {
     /// Computes it (None where it does not apply, such as SSIM on a film smaller than its
     /// window).
     pub compute: Compute,
+    /// Why it does not apply to a film of this width and height, if it does not.
+    pub not_applicable: fn(u32, u32) -> Option<&'static str>,
 }
 
 macro_rules! metrics {
+    (@not_applicable) => { |_, _| None };
+    (@not_applicable $na:expr) => { $na };
     ($($variant:ident {
         slug: $slug:literal, long: $long:literal, short: $short:literal, field: $field:ident,
         eps: $eps:ident, tone_mapped: $tone:literal, detail: $detail:literal,
-        compute: $compute:expr, hand: $hand:path, doc: $doc:literal $(,)?
+        compute: $compute:expr, hand: $hand:path, doc: $doc:literal
+        $(, not_applicable: $na:expr)? $(,)?
     })*) => {
         /// An error of a render against the reference. MSE and relMSE are corrected for the
         /// reference's noise and have predicted values (they can be `primary`); the others
@@ -80,6 +85,7 @@ macro_rules! metrics {
             value: |r: &Row| r.$field,
             set: |r: &mut Row, v| r.$field = v,
             compute: $compute,
+            not_applicable: metrics!(@not_applicable $($na)?),
         },)*];
 
         /// Each registered metric's hand-computed case (a function beside the metric, given
@@ -122,6 +128,7 @@ metrics! {
         },
         hand: ssim::hand::ssim_error,
         doc: "1 - SSIM on tone-mapped sRGB.",
+        not_applicable: |w, h| ssim::not_applicable(w as usize, h as usize),
     }
     Flip {
         slug: "flip", long: "flip", short: "FLIP", field: flip, eps: None,
@@ -250,14 +257,6 @@ struct MetricRow<'a> {
     value: Option<f64>,
     /// Why the value is empty ("" when there is one).
     note: String,
-}
-
-/// Why metric `m` does not apply to a `w` x `h` film, if it does not (the metric's own rule).
-pub fn not_applicable(m: ErrorMetric, w: u32, h: u32) -> Option<&'static str> {
-    match m {
-        ErrorMetric::Ssim => crate::metrics::ssim::not_applicable(w as usize, h as usize),
-        _ => None,
-    }
 }
 
 /// `metrics.csv`: every run's every measured metric, one per row, each row naming the

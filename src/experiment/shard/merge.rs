@@ -2,7 +2,7 @@
 //! (also what the sweep's shards need first), then every run's row and kept image into
 //! results.csv, figures and report, exactly as a one-machine run writes them.
 
-use super::status::{incomplete, progress};
+use super::status::{incomplete, StageProgress};
 use super::unitfile::UnitResult;
 use super::units::Stage;
 use super::{open, Planned};
@@ -30,13 +30,9 @@ pub(crate) fn merge_reference(p: &Planned) -> Result<Reference, String> {
     else {
         unreachable!("a constant reference is always there");
     };
-    let sp = progress(p, Stage::Reference);
-    if !sp.complete() {
-        return Err(incomplete(p, Stage::Reference, &sp));
-    }
     let mut acc: Option<Accum> = None;
-    for i in p.plan.of_stage(Stage::Reference) {
-        let chunk = p.read(i)?.accum.expect("checked by Planned::read");
+    for (_, r) in stage_rows(p, Stage::Reference)? {
+        let chunk = r.accum.expect("checked by Planned::load");
         match &mut acc {
             Some(a) => a.merge(&chunk),
             None => acc = Some(chunk),
@@ -62,16 +58,26 @@ pub(crate) fn merge_reference(p: &Planned) -> Result<Reference, String> {
     Ok(r)
 }
 
-/// Rows of the units of `stage`, in plan order (all must be done).
+/// The units of `stage`, in plan order, each read and checked once; an error names the
+/// missing or damaged ones and the shards to rerun.
 pub(crate) fn stage_rows(p: &Planned, stage: Stage) -> Result<Vec<(usize, UnitResult)>, String> {
-    let sp = progress(p, stage);
+    let mut sp = StageProgress::default();
+    let mut units = Vec::new();
+    for i in p.plan.of_stage(stage) {
+        sp.total += 1;
+        match p.load(i) {
+            Ok(Some(r)) => {
+                sp.done += 1;
+                units.push((i, r));
+            }
+            Ok(None) => sp.missing.push(i),
+            Err(e) => sp.bad.push((i, e)),
+        }
+    }
     if !sp.complete() {
         return Err(incomplete(p, stage, &sp));
     }
-    p.plan
-        .of_stage(stage)
-        .map(|i| Ok((i, p.read(i)?)))
-        .collect()
+    Ok(units)
 }
 
 /// `directlab merge`: the reference from its chunks, then (unless `only` is the reference)
@@ -103,7 +109,7 @@ pub fn merge(
         let u = &p.plan.units[i];
         let row = r.row.expect("checked by stage_rows");
         if u.image {
-            let acc = r.accum.expect("checked by Planned::read");
+            let acc = r.accum.expect("checked by Planned::load");
             let tag = match u.stage {
                 Stage::Timed => time_tag(u.budget),
                 _ => spp_tag(u.spp),

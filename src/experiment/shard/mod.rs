@@ -64,11 +64,7 @@ pub fn shard_count(n: u64) -> Result<u32, String> {
 
 /// `--shards N` on the command line.
 pub fn parse_shards(s: &str) -> Result<u32, String> {
-    let n = s
-        .trim()
-        .parse::<u64>()
-        .map_err(|_| format!("'{s}' is not a whole number"))?;
-    shard_count(n)
+    limits::parser("the shard count", 1, limits::SHARDS)(s).map(|n| n as u32)
 }
 
 /// An experiment with its plan.
@@ -101,32 +97,22 @@ impl Planned {
     /// Whether unit `i` is finished: Ok(false) when absent, Err(reason) when its file is
     /// not this unit's, is damaged or does not hold what the plan says.
     fn done(&self, i: usize) -> Result<bool, String> {
+        self.load(i).map(|r| r.is_some())
+    }
+
+    /// Unit `i`'s result, checked against the plan (the film's size, the sample count, the
+    /// row's column, seed and reference): None when its file is absent, Err naming the file
+    /// when it is not this unit's, is damaged or holds something else.
+    fn load(&self, i: usize) -> Result<Option<UnitResult>, String> {
         let path = self.unit_path(i);
         if std::fs::symlink_metadata(&path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound)
         {
-            return Ok(false);
+            return Ok(None);
         }
         let r = unitfile::read(&path, self.owner(i))?;
         self.check_unit(i, &r)
             .map_err(|why| format!("{}: unit file {why}", path.display()))?;
-        Ok(true)
-    }
-
-    /// Unit `i`'s result, checked against the plan: the film's size, the sample count, the
-    /// row's column, seed and reference. Errors name the file and its shard.
-    fn read(&self, i: usize) -> Result<UnitResult, String> {
-        let path = self.unit_path(i);
-        let r = unitfile::read(&path, self.owner(i))
-            .and_then(|r| {
-                self.check_unit(i, &r)
-                    .map(|_| r)
-                    .map_err(|why| format!("{}: unit file {why}", path.display()))
-            })
-            .map_err(|e| {
-                let shard = self.plan.assignment(self.plan.shards)[i];
-                format!("{e} (shard {shard}/{})", self.plan.shards)
-            })?;
-        Ok(r)
+        Ok(Some(r))
     }
 
     /// What unit `i`'s file must hold, given the plan and the scene.

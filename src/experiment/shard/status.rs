@@ -30,7 +30,7 @@ impl StageProgress {
     }
 }
 
-pub(crate) fn progress(p: &Planned, stage: Stage) -> StageProgress {
+fn progress(p: &Planned, stage: Stage) -> StageProgress {
     let mut sp = StageProgress::default();
     for i in p.plan.of_stage(stage) {
         sp.total += 1;
