@@ -55,11 +55,13 @@ pub(crate) fn has_image(p: &Option<PathBuf>) -> bool {
         .is_none_or(|p| p.exists() && variance_path(p).exists())
 }
 
-/// What the sweep covers, and which seed-0 images the figures need.
+/// What the sweep covers, which seed-0 images the figures need and at which spp every
+/// seed's image is kept.
 pub(crate) struct Sweep<'a> {
     pub(crate) spp: &'a [u32],
     pub(crate) seeds: u32,
     pub(crate) keep_spp: &'a [u32],
+    pub(crate) every_seed: Option<u32>,
     pub(crate) dir: &'a Path,
 }
 
@@ -70,8 +72,9 @@ pub(crate) fn plan_sweep(results: &Results, kept: &[(String, Method)], sw: &Swee
     for seed in 0..sw.seeds as u64 {
         for &spp in sw.spp {
             for (name, s) in kept {
-                let image = (seed == 0 && sw.keep_spp.contains(&spp))
-                    .then(|| image_path(sw.dir, &s.label(), &spp_tag(spp), seed));
+                let image = ((seed == 0 && sw.keep_spp.contains(&spp))
+                    || sw.every_seed == Some(spp))
+                .then(|| image_path(sw.dir, &s.label(), &spp_tag(spp), seed));
                 let done = results.find_sweep(&s.label(), spp, seed).is_some();
                 if !done || !has_image(&image) {
                     jobs.push(Job {
@@ -132,6 +135,7 @@ mod tests {
             spp: &[1, 4],
             seeds: 2,
             keep_spp: &[4],
+            every_seed: None,
             dir: &dir,
         };
         let planned = |res: &Results| -> Vec<(u32, u64)> {

@@ -276,6 +276,7 @@ impl Setup {
                 spp: &x.spp,
                 seeds: x.seeds,
                 keep_spp: &self.keep_spp(),
+                every_seed: x.figures.seed_images.then(|| self.exp.equal_spp()),
                 dir: &self.dir,
             },
         )

@@ -227,6 +227,12 @@ pub struct FiguresSpec {
     /// Probe mode: the cases drawn as panels of `convergence.png`.
     #[serde(default)]
     pub panels: Vec<String>,
+    /// Keep every seed's image at the comparison spp (not only seed 0's), for the viewer.
+    #[serde(default)]
+    pub seed_images: bool,
+    /// The viewer's page budget in MB: images are embedded at full resolution up to it and
+    /// box-averaged beyond it (default [`crate::report::html::sweep::PAGE_MB`]).
+    pub page_mb: Option<f64>,
 }
 
 /// What `--quick` replaces. Crops are fractional and need no override.

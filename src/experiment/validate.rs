@@ -195,6 +195,15 @@ pub(crate) fn validate(exp: &Experiment, file: &Path) -> Result<(), String> {
     }
     if let Some(v) = exp
         .figures
+        .page_mb
+        .filter(|v| !(v.is_finite() && *v >= 0.1))
+    {
+        return fail(format!(
+            "figures.page_mb = {v}: expected the viewer's page budget in MB, at least 0.1"
+        ));
+    }
+    if let Some(v) = exp
+        .figures
         .progression
         .iter()
         .find(|v| !exp.spp.contains(v))
@@ -274,6 +283,8 @@ pub(crate) fn validate_cases(exp: &Experiment, cases: &[Case], file: &Path) -> R
         ("figures.progression", !exp.figures.progression.is_empty()),
         ("figures.crops", !exp.figures.crops.is_empty()),
         ("figures.exposure", exp.figures.exposure.is_some()),
+        ("figures.seed_images", exp.figures.seed_images),
+        ("figures.page_mb", exp.figures.page_mb.is_some()),
     ];
     if let Some((key, _)) = image_only.iter().find(|(_, set)| *set) {
         return fail(format!("{key} needs images; probe mode draws none"));

@@ -1,7 +1,9 @@
 //! The HTML reports in a real browser: headless Chromium (Debian's `chromium`) loads every
 //! page `reproduce --quick`, `extreme --quick` and `chi2` write, with `#selftest`. A sweep's
-//! page switches images, changes the exposure, holds the reference and shows the error maps,
-//! checking its own canvas; every page sorts its tables and checks that its figures are all
+//! page switches images (keys, arrows, the picker past the ninth), changes the exposure (its
+//! number shown), holds the reference, shows the error maps with numbered colour bars, reads
+//! the pixel under a moved mouse, keeps side by side in one row, writes the view into the
+//! address and restores it from one, checking its own canvas; every page sorts its tables and checks that its figures are all
 //! there and load. The page writes a pass/fail line this test reads; any uncaught script error
 //! fails it, and a screenshot must not be blank. Without Chromium the test says why and is
 //! skipped, unless DIRECTLAB_REQUIRE_CHROMIUM=1 (set by `.ci/run` once it is installed).
@@ -41,6 +43,8 @@ fn selftest_line(browser: &str, page: &Path) -> (String, String) {
             "--disable-gpu",
             "--enable-logging=stderr",
             "--virtual-time-budget=10000",
+            // The window of the issue where side by side used to stack.
+            "--window-size=1400,900",
             "--dump-dom",
         ])
         .arg(&url)
