@@ -8,7 +8,9 @@
 //! away; "grazing" sees the light at cos(theta_light) of about 0.01. Small or thin lights are tested in a window
 //! fitted to them ([`Tangent`]); lights covering much of the sky on the whole sphere.
 
+use super::exact::{self, triangle_pdf, LightTriangle};
 use super::probe::LightProbe;
+use super::run_given;
 use super::tangent::Tangent;
 use super::{run_continuous, Case, CaseConfig, Outcome};
 use crate::emitter::{EmitterSelection, LightSampling};
@@ -89,7 +91,7 @@ fn edge_view(a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
 }
 
 /// Reference points (name, position) for a light of the given shape kind.
-fn viewpoints(kind: &str) -> Vec<(&'static str, Vec3)> {
+pub(crate) fn viewpoints(kind: &str) -> Vec<(&'static str, Vec3)> {
     let m = unequal_mesh_positions();
     let (close, grazing) = match kind {
         "triangle" => (
@@ -132,9 +134,20 @@ fn mode_name(m: LightSampling) -> &'static str {
     crate::named::Named::name(m)
 }
 
-/// Tests a probe in a window fitted to its lights when they are small enough, else on the
-/// whole sphere.
+/// Tests a probe: triangle lights against exact cell masses in a window fitted to them
+/// ([`run_exact`]), others by [`run_integrated`].
 pub fn run_probe(name: &str, probe: &LightProbe, cfg: &CaseConfig, window: bool) -> Outcome {
+    if window {
+        if let Some(out) = run_exact(name, probe, cfg, &|t, d| triangle_pdf(probe, t, d)) {
+            return out;
+        }
+    }
+    run_integrated(name, probe, cfg, window)
+}
+
+/// Tests a probe against cell masses integrated numerically from its pdf: in a window fitted
+/// to its lights when they are small enough, else on the whole sphere.
+pub fn run_integrated(name: &str, probe: &LightProbe, cfg: &CaseConfig, window: bool) -> Outcome {
     let (axis, dirs, max_angle) = probe.extent();
     if window && max_angle.to_degrees() < WINDOW_MAX_ANGLE_DEG {
         let w = Tangent::fit(axis, &dirs, cfg.resolution);
@@ -150,6 +163,21 @@ pub fn run_probe(name: &str, probe: &LightProbe, cfg: &CaseConfig, window: bool)
             vec![],
         )
     }
+}
+
+/// Tests a probe of triangle lights against exact cell masses ([`super::exact`]), with
+/// `pdf(triangle, d)` the density through one triangle (its pmf excluded); None when its
+/// lights are not all triangles in front of one window.
+pub fn run_exact(
+    name: &str,
+    probe: &LightProbe,
+    cfg: &CaseConfig,
+    pdf: &dyn Fn(&LightTriangle, Vec3) -> f64,
+) -> Option<Outcome> {
+    let w = exact::window(probe, cfg.resolution)?;
+    let tris = exact::light_triangles(probe)?;
+    let masses = exact::cell_masses(&w, &tris, probe.ref_p, &|t, d| t.pmf * pdf(t, d))?;
+    Some(run_given(name, &w, |r| probe.sample(r), &masses, cfg))
 }
 
 fn probe_case(name: String, about: String, probe: LightProbe, window: bool) -> Case {

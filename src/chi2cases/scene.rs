@@ -78,46 +78,13 @@ pub fn cases(
              whose density the grid can afford"
         ));
     } else {
-        let (w, h) = (scene.camera.width, scene.camera.height);
-        let film = [
-            (0.5, 0.5),
-            (0.25, 0.25),
-            (0.75, 0.25),
-            (0.25, 0.75),
-            (0.75, 0.75),
-        ];
-        let mut rng = Rng::new(0, 7);
-        for (k, (fx, fy)) in film.into_iter().enumerate() {
-            let (px, py) = ((fx * w as f32) as u32, (fy * h as f32) as u32);
-            let ray = scene
-                .camera
-                .generate_ray(px.min(w - 1), py.min(h - 1), &mut rng);
-            let Some(hit) = scene.intersect(&ray) else {
-                left.push(format!(
-                    "receiver {k}: the camera ray through ({px}, {py}) hits nothing"
-                ));
-                continue;
-            };
-            if scene.emitter_at(&hit.sp).is_some() {
-                left.push(format!(
-                    "receiver {k}: the camera ray through ({px}, {py}) hits an emitter"
-                ));
-                continue;
-            }
-            let sp = hit.sp;
-            let mut probe = LightProbe::new(scene.clone(), selection, sp.p, mode);
-            probe.normal = sp.ns;
-            let sel = selection.name();
-            let name = format!("scene/lights-{sel}-receiver{k}");
-            let about = format!(
-                "the scene's lights chosen by {sel}, sampled from {} (normal {}) at pixel \
-                 ({px}, {py})",
-                sp.p, sp.ns
-            );
+        let (probes, why) = receivers(&scene, selection, mode);
+        left.extend(why);
+        for (k, about, probe) in probes {
+            let name = format!("scene/lights-{}-receiver{k}", selection.name());
             let label = name.clone();
-            // A window fitted to the lights' directions resolves a light seen edge-on (a
-            // sliver that the whole sphere's grid cannot: the ceiling light seen from just
-            // under the ceiling). Spheres stay on the whole sphere: a window fitted from a
+            // Triangle lights are tested against exact cell masses in a window fitted to them
+            // ([`super::exact`]). Spheres stay on the whole sphere: a window fitted from a
             // point near one (Veach's plates under its spheres) can miss the edge of its
             // silhouette, and a sample outside the window fails a correct sampler.
             let window = !has_sphere_light;
@@ -128,3 +95,55 @@ pub fn cases(
     }
     (out, left)
 }
+
+/// The light probes of the scene's receivers, the first hits of camera rays through five
+/// points of the film, as (index, description, probe), and the receivers left out with why.
+pub fn receivers(
+    scene: &Arc<Scene>,
+    selection: EmitterSelection,
+    mode: LightSampling,
+) -> (Vec<(usize, String, LightProbe)>, Vec<String>) {
+    let (mut out, mut left) = (Vec::new(), Vec::new());
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let film = [
+        (0.5, 0.5),
+        (0.25, 0.25),
+        (0.75, 0.25),
+        (0.25, 0.75),
+        (0.75, 0.75),
+    ];
+    let mut rng = Rng::new(0, 7);
+    for (k, (fx, fy)) in film.into_iter().enumerate() {
+        let (px, py) = ((fx * w as f32) as u32, (fy * h as f32) as u32);
+        let ray = scene
+            .camera
+            .generate_ray(px.min(w - 1), py.min(h - 1), &mut rng);
+        let Some(hit) = scene.intersect(&ray) else {
+            left.push(format!(
+                "receiver {k}: the camera ray through ({px}, {py}) hits nothing"
+            ));
+            continue;
+        };
+        if scene.emitter_at(&hit.sp).is_some() {
+            left.push(format!(
+                "receiver {k}: the camera ray through ({px}, {py}) hits an emitter"
+            ));
+            continue;
+        }
+        let sp = hit.sp;
+        let mut probe = LightProbe::new(scene.clone(), selection, sp.p, mode);
+        probe.normal = sp.ns;
+        let about = format!(
+            "the scene's lights chosen by {}, sampled from {} (normal {}) at pixel ({px}, {py})",
+            selection.name(),
+            sp.p,
+            sp.ns
+        );
+        out.push((k, about, probe));
+    }
+    (out, left)
+}
+
+#[cfg(test)]
+#[path = "scene_tests.rs"]
+mod tests;

@@ -105,6 +105,23 @@ impl Tangent {
         Tangent::fit(n, &rim, resolution)
     }
 
+    /// The window's axis.
+    pub fn axis(&self) -> DVec3 {
+        self.n
+    }
+
+    /// Where the direction `d` meets the window's plane, in its (x, y); None for directions
+    /// not in front of it.
+    pub fn project(&self, d: DVec3) -> Option<[f64; 2]> {
+        let z = d.dot(self.n);
+        (z > 0.0).then(|| [d.dot(self.s) / z, d.dot(self.t) / z])
+    }
+
+    /// The unit direction through the window's point (x, y), in f64.
+    pub fn direction(&self, x: f64, y: f64) -> DVec3 {
+        (self.n + x * self.s + y * self.t).normalize()
+    }
+
     /// Converts a solid-angle pdf into a density per unit area of the window's plane.
     pub fn plane_pdf(&self, pdf: impl Fn(Vec3) -> f64) -> impl Fn(Vec3) -> f64 {
         let n = self.n;

@@ -121,21 +121,31 @@ fn cases_draw_independent_streams() {
 
 #[test]
 fn grazing_tip_needs_boundary_integration() {
-    // Control for the integration settings of CaseConfig: with the engine's plain
-    // integration the far corner of the grazing mesh light gets expected count 0 and the
-    // correct sampler is rejected; with boundary re-integration (and the engine's recheck of
-    // sampled-but-empty cells) it passes. N = 100k, resolution 25, alpha 0.01.
-    let case = select("emitter/mesh-area-grazing").pop().unwrap();
+    // Control for the numerical integration settings of CaseConfig (triangle lights now get
+    // exact cell masses, spheres and every other domain still integrate): with the engine's
+    // plain integration the far corner of the grazing mesh light gets expected count 0 and
+    // the correct sampler is rejected; with boundary re-integration (and the engine's recheck
+    // of sampled-but-empty cells) it passes. N = 100k, resolution 25, alpha 0.01.
+    use crate::emitter::{EmitterSelection, LightSampling};
+    let scene = emitters::build(vec![emitters::unequal_mesh()]);
+    let (_, p) = emitters::viewpoints("mesh")[1];
+    let probe = probe::LightProbe::new(scene, EmitterSelection::Uniform, p, LightSampling::Area);
     let mut plain = small(1);
     plain.integration = crate::stats::Integration {
         boundary_split: 0,
         recheck_split: 0,
         ..crate::stats::Integration::default()
     };
-    let o = case.run(&plain);
+    let o = emitters::run_integrated("plain", &probe, &plain, true);
     assert!(!o.passed(), "{}", o.summary());
-    let o = case.run(&small(1));
+    let o = emitters::run_integrated("refined", &probe, &small(1), true);
     assert!(o.passed(), "{}", o.summary());
+    let o = emitters::run_probe("exact", &probe, &plain, true);
+    assert!(
+        o.passed(),
+        "exact cell masses need no refinement: {}",
+        o.summary()
+    );
 }
 
 #[test]

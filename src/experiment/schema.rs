@@ -231,9 +231,12 @@ pub struct FiguresSpec {
     #[serde(default)]
     pub seed_images: bool,
     /// The viewer's page budget in MB: images are embedded at full resolution up to it and
-    /// box-averaged beyond it (default [`crate::report::html::sweep::PAGE_MB`]).
+    /// box-averaged beyond it (default [`PAGE_MB`]).
     pub page_mb: Option<f64>,
 }
+
+/// The viewer's default page budget in MB (of embedded image data).
+pub const PAGE_MB: f64 = 32.0;
 
 /// What `--quick` replaces. Crops are fractional and need no override.
 #[derive(Clone, Debug, Deserialize, Default)]

@@ -308,36 +308,90 @@ fn categories(result: &Chi2Result, cfg: &Chi2Config) -> Result<Vec<(f64, f64)>, 
     Ok(cells)
 }
 
-/// Runs the sampler `cfg.samples` times and tests its histogram against `pdf`.
-pub fn chi2_test<D: Domain>(
+/// The sampler's histogram on a domain's grid.
+struct Histogram {
+    observed: Grid,
+    lost: u64,
+    outside: u64,
+    first_outside: Option<String>,
+}
+
+fn histogram<D: Domain>(
     domain: &D,
     mut sampler: impl FnMut(&mut Rng) -> Option<D::Point>,
-    pdf: impl Fn(D::Point) -> f64,
     cfg: &Chi2Config,
-) -> Chi2Result {
+) -> Histogram {
     let (cols, rows) = domain.resolution();
-    let n = cfg.samples;
-    let nf = n as f64;
-    let mut observed = Grid::new(cols, rows);
-    let (mut lost, mut outside) = (0u64, 0u64);
-    let mut first_outside = None;
+    let mut h = Histogram {
+        observed: Grid::new(cols, rows),
+        lost: 0,
+        outside: 0,
+        first_outside: None,
+    };
     let mut rng = Rng::new(cfg.seed, 0);
-    for _ in 0..n {
+    for _ in 0..cfg.samples {
         match sampler(&mut rng).map(|p| domain.cell_of(p)) {
-            None => lost += 1,
-            Some(Ok((c, r))) => observed.data[r * cols + c] += 1.0,
+            None => h.lost += 1,
+            Some(Ok((c, r))) => h.observed.data[r * cols + c] += 1.0,
             Some(Err(why)) => {
-                outside += 1;
-                first_outside.get_or_insert(why);
+                h.outside += 1;
+                h.first_outside.get_or_insert(why);
             }
         }
     }
+    h
+}
 
-    let (fractions, bad_pdf) = cell_integrals_seen(domain, &pdf, &cfg.integration, Some(&observed));
+/// Runs the sampler `cfg.samples` times and tests its histogram against `pdf`.
+pub fn chi2_test<D: Domain>(
+    domain: &D,
+    sampler: impl FnMut(&mut Rng) -> Option<D::Point>,
+    pdf: impl Fn(D::Point) -> f64,
+    cfg: &Chi2Config,
+) -> Chi2Result {
+    let h = histogram(domain, sampler, cfg);
+    let (fractions, bad_pdf) =
+        cell_integrals_seen(domain, &pdf, &cfg.integration, Some(&h.observed));
+    judge(domain, h, &fractions, bad_pdf, cfg)
+}
+
+/// [`chi2_test`] against cell masses the caller worked out (exactly, from the geometry of
+/// the density's support): `fractions` holds each cell's integral of the pdf.
+pub fn chi2_test_given<D: Domain>(
+    domain: &D,
+    sampler: impl FnMut(&mut Rng) -> Option<D::Point>,
+    fractions: &Grid,
+    cfg: &Chi2Config,
+) -> Chi2Result {
+    let h = histogram(domain, sampler, cfg);
+    assert_eq!(
+        (fractions.cols, fractions.rows),
+        domain.resolution(),
+        "cell masses on another grid"
+    );
+    let bad = fractions.data.iter().filter(|x| !(**x >= 0.0)).count() as u64;
+    judge(domain, h, fractions, bad, cfg)
+}
+
+fn judge<D: Domain>(
+    domain: &D,
+    h: Histogram,
+    fractions: &Grid,
+    bad_pdf: u64,
+    cfg: &Chi2Config,
+) -> Chi2Result {
+    let n = cfg.samples;
+    let nf = n as f64;
+    let Histogram {
+        observed,
+        lost,
+        outside,
+        first_outside,
+    } = h;
     let pdf_integral = fractions.sum();
     let expected = Grid {
-        data: fractions.data.iter().map(|x| x * nf).collect(),
-        ..fractions
+        data: fractions.data.iter().map(|x| x.max(0.0) * nf).collect(),
+        ..*fractions
     };
 
     let mut result = Chi2Result {

@@ -1,7 +1,8 @@
 //! The image viewer of an image sweep's page: the reference and each strategy's images at the
 //! comparison spp, at the progression's spp and at equal time, every kept seed's too, as HDR
 //! data tone-mapped in the page ([`super::data`], `viewer.js`). Images are embedded at full
-//! resolution while the page stays within its budget (`figures.page_mb`, default [`PAGE_MB`]);
+//! resolution while the page stays within its budget (`figures.page_mb`, default
+//! [`PAGE_MB`]);
 //! beyond it they are box-averaged by the smallest integer factor that fits, and the page says
 //! so.
 
@@ -10,12 +11,10 @@ use crate::experiment::analysis::metric_short;
 use crate::experiment::plan::{image_path, load_image, spp_tag, time_tag};
 use crate::experiment::results::{Row, EQUAL_TIME};
 use crate::experiment::runner::Outcome;
+use crate::experiment::schema::PAGE_MB;
 use crate::film::Image;
 use crate::report::tables::{metric_means, raw_metric};
 use serde_json::json;
-
-/// The viewer's default page budget in MB (of embedded image data).
-pub const PAGE_MB: f64 = 32.0;
 
 const VIEWER: &str = include_str!("viewer.js");
 
