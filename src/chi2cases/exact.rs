@@ -12,11 +12,12 @@
 //!
 //! When every emitter triangle lies in one plane the window's axis is that plane's normal:
 //! the projection is then an affine copy of the light, so area sampling is uniform on the
-//! window and no light is a sliver, however it is seen from the receiver.
+//! window and no light is a sliver, however it is seen from the receiver. (Sampled uniformly
+//! in solid angle, a light over much of the sky still puts most samples in the window's
+//! middle cells: the test is correct there but has little power.)
 
 use super::probe::LightProbe;
 use super::tangent::Tangent;
-use crate::emitter::LightSampling;
 use crate::geometry::ShapeKind;
 use crate::stats::Grid;
 use glam::{DVec3, Vec2, Vec3};
@@ -117,12 +118,6 @@ pub fn window(probe: &LightProbe, resolution: usize) -> Option<Tangent> {
         None => (probe.extent().0, MIN_COS),
     };
     if !axis.is_finite() || dirs.iter().any(|d| !(d.dot(axis) > min_cos)) {
-        return None;
-    }
-    // Sampled uniformly in solid angle, a light over much of the sky puts nearly every sample
-    // in the window's middle cells (cos³ of the plane's measure): the whole sphere, where that
-    // density is flat, tests it with power.
-    if probe.mode == LightSampling::SolidAngle && dirs.iter().any(|d| d.dot(axis) < 0.5) {
         return None;
     }
     Some(Tangent::fit(axis, &dirs, resolution))
