@@ -116,6 +116,17 @@ fn effective(s: &Strategy, t: &SceneTraits) -> Result<(Strategy, Vec<String>), S
     Ok((e, why))
 }
 
+/// Why every sampler is one estimator here: a film of one pixel whose every run takes one
+/// sample draws a single point, which every sampler makes uniform in the unit cube (a
+/// stratum, a scrambled first point and an independent point alike); None otherwise.
+pub fn samplers_collapse(pixels: u64, spp: &[u32], equal_time: bool) -> Option<String> {
+    (pixels == 1 && !equal_time && spp.iter().all(|&s| s == 1)).then(|| {
+        "a film of one pixel at one sample per run draws one point, uniform under every \
+         sampler"
+            .to_string()
+    })
+}
+
 /// Splits `strategies` (name, strategy) into those to run and those left out.
 pub fn leave_out(
     strategies: &[(String, Strategy)],
@@ -285,6 +296,24 @@ mod tests {
         // On an ordinary scene all three are different estimators.
         let (kept, _) = leave_out(&list, &traits(1));
         assert_eq!(kept.len(), 3);
+    }
+
+    #[test]
+    fn samplers_collapse_only_on_a_single_sample_film() {
+        assert!(samplers_collapse(1, &[1], false).is_some());
+        assert!(samplers_collapse(1, &[1, 1], false).is_some());
+        assert!(
+            samplers_collapse(2, &[1], false).is_none(),
+            "pixels are two draws"
+        );
+        assert!(
+            samplers_collapse(1, &[1, 4], false).is_none(),
+            "4 points can stratify"
+        );
+        assert!(
+            samplers_collapse(1, &[1], true).is_none(),
+            "equal time takes many"
+        );
     }
 
     #[test]

@@ -145,10 +145,15 @@ pub(crate) fn measure(
     };
     let mut not_applicable = Vec::new();
     for d in extra.chosen() {
-        let v = (d.compute)(&inputs);
+        // A metric that does not apply to this film is an empty value with its reason, even
+        // where it would compute a number (trimmed relMSE on a few pixels is relMSE).
+        let why = (d.not_applicable)(out.mean.width, out.mean.height);
+        let v = match why {
+            Some(_) => None,
+            None => (d.compute)(&inputs),
+        };
         if v.is_none() {
-            let why = (d.not_applicable)(out.mean.width, out.mean.height)
-                .unwrap_or("not defined for this image");
+            let why = why.unwrap_or("not defined for this image");
             not_applicable.push(format!("{}: {why}", d.slug));
         }
         (d.set)(&mut row, v);

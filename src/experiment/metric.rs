@@ -103,6 +103,7 @@ metrics! {
         compute: |i| Some(pointwise::trimmed_rel_mse(i.img, i.reference, i.relmse_eps, pointwise::TRIM)),
         hand: pointwise::hand::trimmed_relmse,
         doc: "relMSE without its largest 0.1 % of terms.",
+        not_applicable: |w, h| pointwise::trim_not_applicable(w as usize, h as usize),
     }
     Mape {
         slug: "mape", long: "mape", short: "MAPE", field: mape, eps: Mape,

@@ -4,7 +4,7 @@
 use super::budget::{equal_time_spp, Retime};
 use super::cache::{self, Fnv, KeyInputs, Reference, ReferenceRequest};
 use super::events::{self, Progress};
-use super::leftout::{leave_out, Omission, SceneTraits};
+use super::leftout::{leave_out, samplers_collapse, Omission, SceneTraits};
 use super::measure::{measure, Extra};
 use super::method::{cross, Method};
 use super::plan::{
@@ -168,7 +168,25 @@ fn strategies(
         .iter()
         .map(|s| Ok((s.name.clone(), s.on(base)?)))
         .collect::<Result<_, String>>()?;
-    let (kept, omitted) = leave_out(&listed, &SceneTraits::of(scene));
+    let (kept, mut omitted) = leave_out(&listed, &SceneTraits::of(scene));
+    let mut samplers = exp.exp.samplers.clone();
+    let pixels = scene.camera.width as u64 * scene.camera.height as u64;
+    if let Some(why) = samplers_collapse(pixels, &exp.exp.spp, exp.exp.equal_time.is_some())
+        .filter(|_| samplers.len() > 1)
+    {
+        let first = samplers[0];
+        for &sampler in &samplers[1..] {
+            for (name, strategy) in &kept {
+                let strategy = *strategy;
+                omitted.push(Omission {
+                    name: format!("{name}, {sampler}"),
+                    label: Method { strategy, sampler }.label(),
+                    reason: format!("identical to '{name}, {first}' on this film: {why}"),
+                });
+            }
+        }
+        samplers.truncate(1);
+    }
     for o in &omitted {
         eprintln!(
             "{}: leaving out '{}' ({}): {}",
@@ -179,7 +197,7 @@ fn strategies(
             json!({ "experiment": exp.name, "strategy": o.name, "label": o.label, "reason": o.reason }),
         );
     }
-    Ok((cross(&kept, &exp.exp.samplers), omitted))
+    Ok((cross(&kept, &samplers), omitted))
 }
 
 /// The equal-time runs still to do: each budget, seed and strategy without its row and

@@ -20,6 +20,15 @@ fn mean(v: &[f64]) -> f64 {
 /// The share of relMSE's terms a trimmed relMSE drops: the largest 0.1 %.
 pub const TRIM: f64 = 0.001;
 
+/// Why trimming does not apply to a `w` x `h` film: with fewer than 1 / [`TRIM`] terms (three
+/// per pixel) the largest 0.1 % is no term at all, and trimmed relMSE would be relMSE.
+pub fn trim_not_applicable(w: usize, h: usize) -> Option<&'static str> {
+    ((w * h * 3) as f64 * TRIM < 1.0).then_some(
+        "the film has under 334 pixels: 0.1 % of its terms is none, so nothing would be \
+         trimmed (it would equal relMSE)",
+    )
+}
+
 /// relMSE without its largest `trim` share of terms (x - r)^2 / (r^2 + eps), the count dropped
 /// rounded down: robust to a few fireflies; reported beside relMSE, never instead of it.
 pub fn trimmed_rel_mse(img: &Image, reference: &Image, eps: f64, trim: f64) -> f64 {

@@ -21,4 +21,5 @@ mod render_cli;
 mod shard_cli;
 mod shard_damage;
 mod slurm_e2e;
+mod small_films;
 mod strategies_agree;

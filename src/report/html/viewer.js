@@ -28,6 +28,7 @@
   const srgb = (v) => (v <= 0.0031308 ? 12.92 * v : 1.055 * Math.pow(v, 1 / 2.4) - 0.055);
   function exposure() { return Math.pow(2, parseFloat($("ev").value)) * DL.exposure; }
   function fmt(v) {
+    if (v === null || v === undefined) return "n/a";
     if (v === 0) return "0";
     if (!isFinite(v)) return String(v);
     return Math.abs(v) >= 1e4 || Math.abs(v) < 1e-3 ? v.toExponential(3) : v.toPrecision(4);
