@@ -46,7 +46,7 @@ impl Default for Integration {
 /// Simpson weights of a 3x3 grid, times 36.
 const W3: [f64; 3] = [1.0, 4.0, 1.0];
 
-fn simpson3(f: &[[f64; 3]; 3], area: f64) -> f64 {
+pub(super) fn simpson3(f: &[[f64; 3]; 3], area: f64) -> f64 {
     let mut s = 0.0;
     for (j, row) in f.iter().enumerate() {
         for (i, x) in row.iter().enumerate() {
@@ -85,7 +85,7 @@ pub fn integrate_rect(
 }
 
 /// Whether the nodes suggest an edge or a steep jump that Simpson cannot see as an error.
-fn looks_discontinuous(nodes: &[[f64; 5]; 5], jump_ratio: f64) -> bool {
+pub(super) fn looks_discontinuous(nodes: &[[f64; 5]; 5], jump_ratio: f64) -> bool {
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for &x in nodes.iter().flatten() {
         lo = lo.min(x);
@@ -94,7 +94,7 @@ fn looks_discontinuous(nodes: &[[f64; 5]; 5], jump_ratio: f64) -> bool {
     hi > 0.0 && (lo <= 0.0 || hi > jump_ratio * lo)
 }
 
-fn trapezoid5(h: &[[f64; 5]; 5], area: f64) -> f64 {
+pub(super) fn trapezoid5(h: &[[f64; 5]; 5], area: f64) -> f64 {
     const W: [f64; 5] = [1.0, 2.0, 2.0, 2.0, 1.0];
     let mut s = 0.0;
     for (j, row) in h.iter().enumerate() {

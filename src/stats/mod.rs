@@ -5,6 +5,7 @@ pub mod chi2;
 pub mod domain;
 pub mod heatmap;
 pub mod integrate;
+pub mod integrate_batched;
 pub mod nnls;
 pub mod ratio;
 pub mod slope;
