@@ -45,6 +45,10 @@ pub enum Command {
     /// Chi-square tests of every sampling routine against its pdf (warps, BSDFs, emitters),
     /// with heat maps; exits non-zero if any case fails.
     Chi2(crate::chi2cases::command::Chi2Args),
+    /// Check a sampler written in any language: its program, run after `--`, answers sample
+    /// and pdf requests on stdin/stdout (helpers/python/directlab_sampler.py); exits non-zero
+    /// if it fails.
+    CheckSampler(crate::checksampler::CheckSamplerArgs),
     /// Run Nori test files (`<test type="ttest">`, `<test type="chi2test">`): scenes against
     /// references per strategy, BSDF albedos, BSDF chi-square; exits non-zero on a failure.
     Test(crate::noritest::TestArgs),
@@ -375,6 +379,7 @@ pub fn main() -> i32 {
             ok.then_some(())
                 .ok_or_else(|| "some sampling routines do not match their pdfs".to_string())
         }),
+        Command::CheckSampler(a) => crate::checksampler::command(a),
         Command::Extreme(a) => cmd_extreme(a),
         Command::Labels => {
             print!("{}", crate::labels::grammar());

@@ -13,6 +13,7 @@ pub use directlab_render::{
 pub mod analytic;
 pub mod bench;
 pub mod check;
+pub mod checksampler;
 pub mod chi2cases;
 pub mod choices;
 pub mod cli;

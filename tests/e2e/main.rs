@@ -8,6 +8,7 @@ mod bad_counts;
 mod bad_input;
 mod bench_cli;
 mod browser;
+mod check_sampler;
 mod experiment_cli;
 mod extreme;
 mod html_page;
