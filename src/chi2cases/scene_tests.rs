@@ -10,6 +10,7 @@ use crate::chi2cases::emitters::{run_exact, run_probe};
 use crate::chi2cases::exact::{triangle_pdf, LightTriangle};
 use crate::chi2cases::CaseConfig;
 use crate::sampling::spherical::spherical_triangle_area;
+use crate::stats::ks_uniform;
 
 fn open(rel: &str) -> Arc<Scene> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
@@ -38,16 +39,6 @@ const HARD: [(&str, usize, LightSampling); 5] = [
         LightSampling::SolidAngle,
     ),
 ];
-
-/// Kolmogorov-Smirnov distance of sorted values in [0, 1] from Uniform(0, 1).
-fn ks_uniform(sorted: &[f64]) -> f64 {
-    let n = sorted.len() as f64;
-    sorted
-        .iter()
-        .enumerate()
-        .map(|(i, &p)| (p - i as f64 / n).abs().max(((i + 1) as f64 / n - p).abs()))
-        .fold(0.0, f64::max)
-}
 
 /// The hard scenes under uniform and power emitter choice (one run where a scene has one
 /// light: both choices are then the same estimator) x 20 seeds: 140 p-values, whose KS

@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::stats::domain::{Disk, Sphere, Triangle, UnitSquare};
+use crate::stats::ks_uniform;
 use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
 
@@ -421,16 +422,6 @@ fn area_light_silhouette_passes_and_missing_cosine_fails() {
     eprintln!("quad light without cos: {}", r.reason);
     assert!(!r.passed());
     assert!(r.p_value < 1e-6);
-}
-
-/// Kolmogorov-Smirnov distance of sorted values in [0, 1] from Uniform(0, 1).
-fn ks_uniform(sorted: &[f64]) -> f64 {
-    let n = sorted.len() as f64;
-    sorted
-        .iter()
-        .enumerate()
-        .map(|(i, &p)| (p - i as f64 / n).abs().max(((i + 1) as f64 / n - p).abs()))
-        .fold(0.0, f64::max)
 }
 
 /// The engine is calibrated: for a correct sampler its p-values are uniform. 40 seeds of

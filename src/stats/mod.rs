@@ -41,3 +41,15 @@ pub fn top_share(mut e: Vec<f64>) -> f64 {
     e.select_nth_unstable_by(i, f64::total_cmp);
     e[i..].iter().sum::<f64>() / total
 }
+
+/// Kolmogorov-Smirnov distance of sorted values in [0, 1] from Uniform(0, 1) (the tests'
+/// check that p-values of correct samplers are uniform).
+#[cfg(test)]
+pub(crate) fn ks_uniform(sorted: &[f64]) -> f64 {
+    let n = sorted.len() as f64;
+    sorted
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| (p - i as f64 / n).abs().max(((i + 1) as f64 / n - p).abs()))
+        .fold(0.0, f64::max)
+}

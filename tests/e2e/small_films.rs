@@ -4,6 +4,18 @@
 use crate::common;
 use crate::experiment_cli::FURNACE;
 use common::{directlab, run, scratch};
+use std::path::{Path, PathBuf};
+
+/// The furnace on a 1x1 film, and `experiment` (TOML) beside it; returns the experiment file.
+fn one_pixel(out: &Path, experiment: &str) -> PathBuf {
+    let one = FURNACE
+        .replace(r#"name="width" value="6""#, r#"name="width" value="1""#)
+        .replace(r#"name="height" value="4""#, r#"name="height" value="1""#);
+    std::fs::write(out.join("furnace.xml"), one).unwrap();
+    let exp = out.join("furnace.toml");
+    std::fs::write(&exp, experiment).unwrap();
+    exp
+}
 
 /// A 1x1 film at one sample per run: every sampler draws one uniform point, so stratified and
 /// sobol are left out as the same estimator as independent (stderr and a `left_out` event
@@ -12,13 +24,8 @@ use common::{directlab, run, scratch};
 #[test]
 fn a_one_sample_film_keeps_one_sampler_and_says_why() {
     let out = scratch("one-sample");
-    let one = FURNACE
-        .replace(r#"name="width" value="6""#, r#"name="width" value="1""#)
-        .replace(r#"name="height" value="4""#, r#"name="height" value="1""#);
-    std::fs::write(out.join("furnace.xml"), one).unwrap();
-    let exp = out.join("furnace.toml");
-    std::fs::write(
-        &exp,
+    let exp = one_pixel(
+        &out,
         r#"
 scene = "furnace.xml"
 spp = [1]
@@ -32,8 +39,7 @@ report = ["trimmed-relmse"]
 name = "light"
 strategy = "light"
 "#,
-    )
-    .unwrap();
+    );
     let o = run(directlab()
         .args(["run", exp.to_str().unwrap(), "--json", "--out"])
         .arg(&out));
@@ -84,13 +90,8 @@ strategy = "light"
 #[test]
 fn a_one_pixel_film_still_flags_a_bias_and_says_what_does_not_apply() {
     let out = scratch("one-pixel");
-    let one = FURNACE
-        .replace(r#"name="width" value="6""#, r#"name="width" value="1""#)
-        .replace(r#"name="height" value="4""#, r#"name="height" value="1""#);
-    std::fs::write(out.join("furnace.xml"), one).unwrap();
-    let exp = out.join("furnace.toml");
-    std::fs::write(
-        &exp,
+    let exp = one_pixel(
+        &out,
         r#"
 scene = "furnace.xml"
 spp = [64, 16384]
@@ -103,8 +104,7 @@ report = ["ssim"]
 name = "light"
 strategy = "light"
 "#,
-    )
-    .unwrap();
+    );
     let o = run(directlab()
         .args(["run", exp.to_str().unwrap(), "--json", "--out"])
         .arg(&out));
