@@ -105,6 +105,20 @@ pub(super) fn trapezoid5(h: &[[f64; 5]; 5], area: f64) -> f64 {
     s * area / 64.0
 }
 
+/// The four 3x3 node grids of a 5x5 grid's quadrants: (0, 0), (1, 0), (0, 1), (1, 1).
+pub(super) fn quadrants(h: &[[f64; 5]; 5]) -> [[[f64; 3]; 3]; 4] {
+    let quad = |qi: usize, qj: usize| {
+        let mut q = [[0.0; 3]; 3];
+        for (j, row) in q.iter_mut().enumerate() {
+            for (i, x) in row.iter_mut().enumerate() {
+                *x = h[2 * qj + j][2 * qi + i];
+            }
+        }
+        q
+    };
+    [quad(0, 0), quad(1, 0), quad(0, 1), quad(1, 1)]
+}
+
 fn refine(
     f: &mut impl FnMut(f64, f64) -> f64,
     u: [f64; 2],
@@ -128,16 +142,7 @@ fn refine(
             };
         }
     }
-    let quad = |qi: usize, qj: usize| {
-        let mut q = [[0.0; 3]; 3];
-        for (j, row) in q.iter_mut().enumerate() {
-            for (i, x) in row.iter_mut().enumerate() {
-                *x = h[2 * qj + j][2 * qi + i];
-            }
-        }
-        q
-    };
-    let quads = [quad(0, 0), quad(1, 0), quad(0, 1), quad(1, 1)];
+    let quads = quadrants(&h);
     let fine: f64 = quads.iter().map(|q| simpson3(q, area / 4.0)).sum();
 
     let peak = h.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs())) * area;

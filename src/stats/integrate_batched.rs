@@ -8,7 +8,7 @@
 //! trapezoid fallback at the last level), so both integrate to the same values up to the
 //! order of summation.
 
-use super::integrate::{looks_discontinuous, simpson3, trapezoid5, Integration};
+use super::integrate::{looks_discontinuous, quadrants, simpson3, trapezoid5, Integration};
 
 /// A rectangle waiting for its 16 refinement nodes.
 struct Pending {
@@ -142,16 +142,7 @@ enum Step {
 fn step(p: &Pending, h: &[[f64; 5]; 5], cfg: &Integration) -> Step {
     let area = (p.u[1] - p.u[0]) * (p.v[1] - p.v[0]);
     let coarse = simpson3(&p.g, area);
-    let quad = |qi: usize, qj: usize| {
-        let mut q = [[0.0; 3]; 3];
-        for (j, row) in q.iter_mut().enumerate() {
-            for (i, x) in row.iter_mut().enumerate() {
-                *x = h[2 * qj + j][2 * qi + i];
-            }
-        }
-        q
-    };
-    let quads = [quad(0, 0), quad(1, 0), quad(0, 1), quad(1, 1)];
+    let quads = quadrants(h);
     let fine: f64 = quads.iter().map(|q| simpson3(q, area / 4.0)).sum();
     let peak = h.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs())) * area;
     let inaccurate = (fine - coarse).abs() > p.tol.max(cfg.rel_tol * fine.abs());
