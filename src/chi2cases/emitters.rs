@@ -174,8 +174,8 @@ pub fn run_exact(
     cfg: &CaseConfig,
     pdf: &dyn Fn(&LightTriangle, Vec3) -> f64,
 ) -> Option<Outcome> {
-    let w = exact::window(probe, cfg.resolution)?;
     let tris = exact::light_triangles(probe)?;
+    let w = exact::window(probe, &tris, cfg.resolution)?;
     let masses = exact::cell_masses(&w, &tris, probe.ref_p, &|t, d| t.pmf * pdf(t, d))?;
     Some(run_given(name, &w, |r| probe.sample(r), &masses, cfg))
 }

@@ -98,11 +98,10 @@ fn barycentrics(p: DVec3, d: DVec3, v: [Vec3; 3]) -> Option<Vec2> {
     Some(Vec2::new(b1 as f32, b2 as f32))
 }
 
-/// The window for the probe's lights: axis the lights' common plane's normal when they are
-/// coplanar, else their mean direction; None when a light is not a mesh or a corner lies
-/// within [`MIN_COS`] of the window's plane.
-pub fn window(probe: &LightProbe, resolution: usize) -> Option<Tangent> {
-    let tris = light_triangles(probe)?;
+/// The window for the probe's lights `tris` ([`light_triangles`]): axis their common plane's
+/// normal when they are coplanar, else their mean direction; None when there are none or a
+/// corner lies within [`MIN_COS`] of the window's plane.
+pub fn window(probe: &LightProbe, tris: &[LightTriangle], resolution: usize) -> Option<Tangent> {
     if tris.is_empty() {
         return None;
     }
@@ -113,7 +112,7 @@ pub fn window(probe: &LightProbe, resolution: usize) -> Option<Tangent> {
         .collect();
     // In the lights' own plane's window any corner in front will do (the projection is an
     // affine copy of the plane); about another axis the cells must not stretch without bound.
-    let (axis, min_cos) = match common_plane(&tris, p) {
+    let (axis, min_cos) = match common_plane(tris, p) {
         Some(n) => (n, 0.0),
         None => (probe.extent().0, MIN_COS),
     };
