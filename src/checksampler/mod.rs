@@ -1,27 +1,23 @@
 //! `directlab check-sampler`: a sampler written in any language, checked by the engine of
 //! directlab's own chi-square cases. The user's program is a pure function of what it is
-//! sent ([`pipe`]): directlab owns the random numbers, the binning, the integration and the
-//! statistics.
-//!
-//! 1. **sample**: N pairs of uniform numbers go out in batches; each comes back as a point,
-//!    the pdf the program claims for it, and a valid flag (0: sampling failed).
-//! 2. **pdf**: the program's pdf at every valid sample must equal the pdf it claimed there;
-//!    then at the nodes of the adaptive cell integration, one batch per refinement level
-//!    ([`crate::stats::integrate_batched`]), so support edges are refined where they are.
-//! 3. Pearson chi-square of the histogram against those cell masses, the pdf-integral check,
-//!    and a heat map of the result.
+//! sent ([`program`], over a [`pipe`]): directlab owns the random numbers, the binning, the
+//! integration and the statistics ([`engine`]).
 
+pub mod engine;
 pub mod pipe;
+pub mod program;
+#[cfg(test)]
+mod tests;
 
-use crate::chi2cases::Check;
-use crate::chi2cases::{run_given, CaseConfig, Outcome};
+use crate::chi2cases::bsdfs::incident;
+use crate::chi2cases::protocol::Target;
+use crate::chi2cases::{CaseConfig, Check, Outcome};
 use crate::limits::Bound;
-use crate::stats::integrate_batched::integrate_rects_batched;
-use crate::stats::{Disk, Domain, Grid};
-use glam::{Vec2, Vec3};
+use crate::sampling::microfacet::MicrofacetDistribution;
+use glam::Vec3;
 use pipe::Pipe;
-use serde_json::json;
-use std::cell::RefCell;
+use program::Program;
+use serde_json::{Map, Value};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -35,22 +31,53 @@ const BATCH: Bound = Bound {
     why: "a message of 4 million rows is 100 MB or more; smaller batches cost nothing",
 };
 
-/// The domain of the sampler's points.
+/// What the sampler samples (the header's "domain"); parameters come from `--param`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum DomainKind {
     /// Points (x, y) of the unit square [0, 1)^2, density per unit area.
     Square,
     /// Points (x, y) of the unit disk, density per unit area.
     Disk,
-    /// Unit directions (x, y, z), density per steradian (hemisphere samplers too).
+    /// Barycentrics (x, y) on the unit right triangle, density per unit area.
+    Triangle,
+    /// Unit directions (x, y, z), density per steradian.
     Sphere,
+    /// Unit directions with z >= 0, density per steradian.
+    Hemisphere,
+    /// Directions with z >= cos_theta_max (`--param cos_theta_max=C`).
+    Cap,
+    /// Directions through a triangle seen from the origin (`--param vertices=[[x,y,z],..]`;
+    /// the built-in case's triangle by default).
+    SphericalTriangle,
+    /// Microfacet normals with density D(m) cos(theta_m) (`--param alpha=A`, optionally
+    /// `alpha_v` and `distribution=beckmann|ggx`).
+    Microfacet,
+    /// A BSDF's outgoing directions for incident directions `--param wi=[x,y,z]` or a list
+    /// (by default normal, oblique, grazing and from below); the program also answers eval.
+    Bsdf,
 }
 
 #[derive(clap::Args, Debug)]
 pub struct CheckSamplerArgs {
-    /// The domain of the points the program returns.
-    #[arg(long, value_enum)]
-    pub domain: DomainKind,
+    /// What the program samples.
+    #[arg(long, value_enum, required_unless_present = "case")]
+    pub domain: Option<DomainKind>,
+    /// A built-in case (see `directlab chi2 --list`) whose sampler the program replaces: its
+    /// domain, parameters, grid and random numbers, so the same warp gets the same p-value.
+    #[arg(long, conflicts_with = "domain")]
+    pub case: Option<String>,
+    /// A parameter sent to the program with every request, KEY=VALUE (VALUE is JSON, or
+    /// else a string); repeatable. The domain's own parameters are read from these too.
+    #[arg(long = "param", value_name = "KEY=VALUE")]
+    pub params: Vec<String>,
+    /// Run every check at this many seeds (--seed, --seed + 1, ...) and test that the
+    /// chi-square p-values are uniform (Kolmogorov-Smirnov at --alpha): the calibration of a
+    /// correct sampler, which one p-value cannot show.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub seeds: u64,
+    /// Uniform numbers sent per sample.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..=16))]
+    pub dims: u64,
     /// Samples drawn.
     #[arg(long, default_value_t = 1_000_000, value_parser = crate::limits::parser("--samples", 100, crate::limits::TEST_SAMPLES))]
     pub samples: u64,
@@ -77,54 +104,73 @@ pub struct CheckSamplerArgs {
     pub command: Vec<String>,
 }
 
-/// A point's coordinates as f64, in and out of the protocol.
-trait Coords: Copy {
-    const DIM: usize;
-    fn read(v: &[f64]) -> Self;
-    fn write(self, out: &mut Vec<f64>);
-}
-
-impl Coords for Vec2 {
-    const DIM: usize = 2;
-    fn read(v: &[f64]) -> Self {
-        Vec2::new(v[0] as f32, v[1] as f32)
-    }
-    fn write(self, out: &mut Vec<f64>) {
-        out.extend([self.x as f64, self.y as f64]);
-    }
-}
-
-impl Coords for Vec3 {
-    const DIM: usize = 3;
-    fn read(v: &[f64]) -> Self {
-        Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
-    }
-    fn write(self, out: &mut Vec<f64>) {
-        out.extend([self.x as f64, self.y as f64, self.z as f64]);
-    }
-}
-
 /// The command: runs the check and prints its verdict; an error when it fails.
 pub fn command(a: &CheckSamplerArgs) -> Result<(), String> {
-    let o = run(a)?;
+    let r = run(a)?;
     let verdict = |ok: bool| if ok { "pass" } else { "FAIL" };
-    println!(
-        "{}: {} ({}); heat map {}",
-        o.name,
-        verdict(o.passed()),
-        o.summary(),
-        a.out.join("heatmap.png").display()
-    );
-    for c in &o.checks {
-        println!("  {}: {} ({})", c.name, verdict(c.passed), c.detail);
+    for (o, map) in &r.outcomes {
+        println!(
+            "{}: {} ({}); heat map {}",
+            o.name,
+            verdict(o.passed()),
+            o.summary(),
+            map.display()
+        );
+        for c in &o.checks {
+            println!("  {}: {} ({})", c.name, verdict(c.passed), c.detail);
+        }
     }
-    o.passed()
-        .then_some(())
-        .ok_or_else(|| "the sampler does not match its pdf".to_string())
+    for (name, c) in &r.calibration {
+        println!("{name}: {}: {} ({})", c.name, verdict(c.passed), c.detail);
+    }
+    let failed = r.outcomes.iter().filter(|(o, _)| !o.passed()).count()
+        + r.calibration.iter().filter(|(_, c)| !c.passed).count();
+    let total = r.outcomes.len() + r.calibration.len();
+    match failed {
+        0 => Ok(()),
+        _ => Err(format!(
+            "the sampler does not match its pdf ({failed} of {total} checks failed)"
+        )),
+    }
 }
 
-/// Runs the check; Ok(outcome) whether it passed or not, Err when the program misbehaved.
-pub fn run(a: &CheckSamplerArgs) -> Result<Outcome, String> {
+/// What a run found: each check with its heat map, and with `--seeds` above 1, the test
+/// of each target's p-values for uniformity.
+pub struct Report {
+    pub outcomes: Vec<(Outcome, PathBuf)>,
+    pub calibration: Vec<(String, Check)>,
+}
+
+/// One check to run: what is sampled, under which name, from which seeds.
+struct Job {
+    target: Target,
+    name: String,
+    seeds: Seeds,
+}
+
+/// How a job's random stream follows from `--seed`.
+enum Seeds {
+    /// The seed itself.
+    Plain,
+    /// As the built-in case of this name draws it, so the streams are the same.
+    Case(String),
+    /// Each incident direction of a BSDF its own stream (k-th), so its tests are independent.
+    Incident(u64),
+}
+
+impl Seeds {
+    fn seed(&self, seed: u64) -> u64 {
+        match self {
+            Seeds::Plain => seed,
+            Seeds::Case(name) => crate::chi2cases::case_seed(name, seed),
+            Seeds::Incident(k) => crate::rng::mix64(seed ^ crate::rng::mix64(k + 1)),
+        }
+    }
+}
+
+/// Runs the checks; Ok(report) whether they passed or not, Err when the program misbehaved
+/// or the arguments are wrong.
+pub fn run(a: &CheckSamplerArgs) -> Result<Report, String> {
     if !(a.timeout.is_finite() && a.timeout > 0.0) {
         return Err(format!(
             "--timeout {}: expected a positive number of seconds",
@@ -134,171 +180,242 @@ pub fn run(a: &CheckSamplerArgs) -> Result<Outcome, String> {
     if !(a.alpha > 0.0 && a.alpha < 1.0) {
         return Err(format!("--alpha {}: expected a level in (0, 1)", a.alpha));
     }
+    let params = parse_params(&a.params)?;
+    let jobs = jobs(a, &params)?;
     let mut pipe = Pipe::start(&a.command, Duration::from_secs_f64(a.timeout))?;
-    let cfg = CaseConfig {
-        samples: a.samples,
-        resolution: a.resolution as usize,
-        seed: a.seed,
-        alpha: a.alpha,
-        ..CaseConfig::default()
-    };
-    let out = match a.domain {
-        DomainKind::Square => check(&mut pipe, a, &cfg, &cfg.square(), "square"),
-        DomainKind::Disk => {
-            let r = cfg.resolution.max(3);
-            check(&mut pipe, a, &cfg, &Disk { n_phi: r, n_r2: r }, "disk")
+    // The run as a whole is at --alpha: each check at the Sidak level over all of them.
+    let runs = jobs.len() * a.seeds as usize;
+    let alpha = crate::stats::sidak(a.alpha, runs);
+    let mut outcomes = Vec::new();
+    let mut calibration = Vec::new();
+    for job in &jobs {
+        let mut sent = job.target.params();
+        if let Value::Object(m) = &mut sent {
+            m.extend(params.clone());
         }
-        DomainKind::Sphere => check(&mut pipe, a, &cfg, &cfg.sphere(), "sphere"),
-    }?;
+        let mut session = engine::Session {
+            program: &mut pipe,
+            target: &job.target,
+            params: sent,
+            dims: a.dims as usize,
+            batch: a.batch as usize,
+            integrals: None,
+        };
+        let mut p_values = Vec::new();
+        for s in 0..a.seeds {
+            let cfg = job.target.config(&CaseConfig {
+                samples: a.samples,
+                resolution: a.resolution as usize,
+                seed: job.seeds.seed(a.seed + s),
+                alpha,
+                ..CaseConfig::default()
+            });
+            let name = match a.seeds {
+                1 => job.name.clone(),
+                _ => format!("{} seed {}", job.name, a.seed + s),
+            };
+            let o = engine::check(&mut session, &cfg, &name)?;
+            p_values.push(o.chi2.p_value);
+            outcomes.push(o);
+        }
+        if a.seeds > 1 {
+            let level = crate::stats::sidak(a.alpha, jobs.len());
+            calibration.push((job.name.clone(), uniformity(p_values, level)));
+        }
+    }
     pipe.finish();
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
-    out.write_heatmap(&a.out.join("heatmap.png"))?;
-    Ok(out)
+    let mut out = Vec::new();
+    for (k, o) in outcomes.into_iter().enumerate() {
+        let file = match runs {
+            1 => "heatmap.png".to_string(),
+            _ => format!("heatmap-{k}.png"),
+        };
+        let path = a.out.join(file);
+        o.write_heatmap(&path)?;
+        out.push((o, path));
+    }
+    Ok(Report {
+        outcomes: out,
+        calibration,
+    })
 }
 
-fn check<D>(
-    pipe: &mut Pipe,
-    a: &CheckSamplerArgs,
-    cfg: &CaseConfig,
-    domain: &D,
-    name: &str,
-) -> Result<Outcome, String>
-where
-    D: Domain,
-    D::Point: Coords,
-{
-    let pdim = D::Point::DIM;
-    let batch = a.batch as usize;
-    // 1. Samples, from uniform numbers drawn here.
-    let mut rng = crate::rng::Rng::new(a.seed, 0);
-    let mut points: Vec<Option<D::Point>> = Vec::with_capacity(a.samples as usize);
-    let mut claimed = Vec::new();
-    let mut left = a.samples as usize;
-    let mut k = 0;
-    while left > 0 {
-        let n = left.min(batch);
-        let u: Vec<f64> = (0..2 * n).map(|_| rng.next_f64()).collect();
-        let head = json!({"phase": "sample", "domain": name, "count": n, "dim": 2});
-        let what = format!("sample phase, batch {k}");
-        let v = pipe.call(head, &u, n, pdim + 2, &what)?;
-        for row in v.chunks_exact(pdim + 2) {
-            let valid = row[pdim + 1] > 0.5;
-            points.push(valid.then(|| D::Point::read(&row[..pdim])));
-            if valid {
-                claimed.push(row[pdim]);
-            }
-        }
-        left -= n;
-        k += 1;
+/// The p-values of one target over seeds against Uniform(0, 1): KS at `alpha`.
+fn uniformity(mut p: Vec<f64>, alpha: f64) -> Check {
+    p.sort_by(f64::total_cmp);
+    let d = crate::stats::ks_uniform(&p);
+    let pv = crate::stats::ks_p_value(d, p.len());
+    Check {
+        name: "uniform p-values",
+        passed: pv >= alpha,
+        detail: format!(
+            "{} seeds: KS distance {d:.3} from uniform, p = {pv:.3} vs {alpha:.2e}; smallest \
+             p-value {:.2e}",
+            p.len(),
+            p[0]
+        ),
     }
-    // 2. The pdf at the samples themselves.
-    let valid: Vec<D::Point> = points.iter().flatten().copied().collect();
-    let at_samples = query(pipe, name, &valid, batch, "pdf phase at the samples")?;
-    let mismatch = claimed
-        .iter()
-        .zip(&at_samples)
-        .enumerate()
-        .filter(|(_, (c, p))| (*c - *p).abs() > 1e-5 * c.abs().max(p.abs()).max(1e-300))
-        .map(|(i, (c, p))| (i, *c, *p))
-        .collect::<Vec<_>>();
-    let claim = Check {
-        name: "claimed pdf",
-        passed: mismatch.is_empty(),
-        detail: match mismatch.first() {
-            None => format!(
-                "the pdf at all {} samples equals the pdf claimed with them",
-                valid.len()
-            ),
-            Some(&(i, c, p)) => format!(
-                "{} of {} samples claim a pdf other than pdf(point): sample {i} claims {c:e}, \
-                 pdf gives {p:e}",
-                mismatch.len(),
-                valid.len()
-            ),
-        },
-    };
-    // 3. Cell masses from the adaptive integration, one batch per level.
-    let (cols, rows) = domain.resolution();
-    let ([u0, u1], [v0, v1]) = domain.bounds();
-    let (du, dv) = ((u1 - u0) / cols as f64, (v1 - v0) / rows as f64);
-    let rects: Vec<([f64; 2], [f64; 2])> = (0..rows * cols)
-        .map(|c| {
-            let (i, j) = ((c % cols) as f64, (c / cols) as f64);
-            (
-                [u0 + i * du, u0 + (i + 1.0) * du],
-                [v0 + j * dv, v0 + (j + 1.0) * dv],
+}
+
+/// `--param KEY=VALUE` as a JSON object (VALUE parsed as JSON, else kept as a string).
+fn parse_params(raw: &[String]) -> Result<Map<String, Value>, String> {
+    let mut m = Map::new();
+    for p in raw {
+        let (k, v) = p
+            .split_once('=')
+            .filter(|(k, _)| !k.is_empty())
+            .ok_or_else(|| format!("--param '{p}': expected KEY=VALUE"))?;
+        let v = serde_json::from_str(v).unwrap_or_else(|_| Value::String(v.to_string()));
+        m.insert(k.to_string(), v);
+    }
+    Ok(m)
+}
+
+fn jobs(a: &CheckSamplerArgs, params: &Map<String, Value>) -> Result<Vec<Job>, String> {
+    if let Some(name) = &a.case {
+        let cases = crate::chi2cases::all_cases();
+        let case = cases.iter().find(|c| &c.name == name).ok_or_else(|| {
+            format!("--case {name}: no such case (`directlab chi2 --list` lists them)")
+        })?;
+        let target = case.external.clone().ok_or_else(|| {
+            let with: Vec<&str> = cases
+                .iter()
+                .filter(|c| c.external.is_some())
+                .map(|c| c.name.as_str())
+                .collect();
+            format!(
+                "--case {name}: this case has no protocol form; these do: {}",
+                with.join(", ")
             )
-        })
-        .collect();
-    let mut failure = None;
-    let mut level = 0;
-    let jac = domain.jacobian();
-    let masses = integrate_rects_batched(
-        &rects,
-        &mut |uv: &[[f64; 2]]| {
-            let pts: Vec<Option<D::Point>> = uv.iter().map(|p| domain.point(p[0], p[1])).collect();
-            let send: Vec<D::Point> = pts.iter().flatten().copied().collect();
-            let what = format!("pdf phase, integration level {level}");
-            level += 1;
-            let got = match failure {
-                Some(_) => Ok(vec![0.0; send.len()]),
-                None => query(pipe, name, &send, batch, &what),
-            };
-            let got = got.unwrap_or_else(|e| {
-                failure = Some(e);
-                vec![0.0; send.len()]
-            });
-            let mut it = got.into_iter();
-            pts.iter()
-                .map(|p| p.map_or(0.0, |_| it.next().unwrap_or(0.0) * jac))
-                .collect()
-        },
-        &cfg.integration,
-        1e-9 / (rows * cols) as f64,
-    );
-    if let Some(e) = failure {
-        return Err(e);
+        })?;
+        return Ok(vec![Job {
+            target,
+            name: format!("check-sampler/{name}"),
+            seeds: Seeds::Case(name.clone()),
+        }]);
     }
-    let grid = Grid {
-        cols,
-        rows,
-        data: masses,
+    let kind = a.domain.expect("clap requires --domain or --case");
+    let one = |target: Target| {
+        vec![Job {
+            name: format!("check-sampler/{}", target.name()),
+            target,
+            seeds: Seeds::Plain,
+        }]
     };
-    let queue = RefCell::new(points.into_iter());
-    let mut o = run_given(
-        &format!("check-sampler/{name}"),
-        domain,
-        |_| queue.borrow_mut().next().flatten(),
-        &grid,
-        cfg,
-    );
-    o.checks.push(claim);
-    Ok(o)
+    let num = |key: &str| -> Result<Option<f32>, String> {
+        params
+            .get(key)
+            .map(|v| {
+                v.as_f64()
+                    .filter(|x| x.is_finite())
+                    .map(|x| x as f32)
+                    .ok_or_else(|| format!("--param {key}={v}: expected a number"))
+            })
+            .transpose()
+    };
+    let need = |key: &str| {
+        num(key)?.ok_or_else(|| {
+            let d = clap::ValueEnum::to_possible_value(&kind).expect("every kind has a name");
+            format!("--domain {} needs --param {key}=VALUE", d.get_name())
+        })
+    };
+    Ok(match kind {
+        DomainKind::Square => one(Target::Square),
+        DomainKind::Disk => one(Target::Disk),
+        DomainKind::Triangle => one(Target::Triangle),
+        DomainKind::Sphere => one(Target::Sphere),
+        DomainKind::Hemisphere => one(Target::Hemisphere),
+        DomainKind::Cap => {
+            let c = need("cos_theta_max")?;
+            if !(-1.0..1.0).contains(&c) {
+                return Err(format!(
+                    "--param cos_theta_max={c}: expected a value in [-1, 1)"
+                ));
+            }
+            one(Target::Cap { cos_theta_max: c })
+        }
+        DomainKind::SphericalTriangle => {
+            let vertices = match params.get("vertices") {
+                None => crate::chi2cases::warps::spherical_triangle_vertices(),
+                Some(v) => vertices(v)?,
+            };
+            one(Target::SphericalTriangle { vertices })
+        }
+        DomainKind::Microfacet => {
+            let au = need("alpha")?;
+            let av = num("alpha_v")?.unwrap_or(au);
+            if !(au > 0.0 && av > 0.0) {
+                return Err(format!(
+                    "--param alpha: expected a positive roughness, got {au}, {av}"
+                ));
+            }
+            let distribution = match params.get("distribution").and_then(Value::as_str) {
+                None | Some("beckmann") => MicrofacetDistribution::Beckmann,
+                Some("ggx") => MicrofacetDistribution::Ggx,
+                Some(d) => {
+                    return Err(format!(
+                        "--param distribution={d}: expected beckmann or ggx"
+                    ))
+                }
+            };
+            one(Target::Normals {
+                distribution,
+                alpha: (au, av),
+            })
+        }
+        DomainKind::Bsdf => {
+            let wis: Vec<(String, Vec3)> = match params.get("wi") {
+                None => incident()
+                    .into_iter()
+                    .map(|(n, w)| (n.to_string(), w))
+                    .collect(),
+                Some(v) => directions(v, "wi")?
+                    .into_iter()
+                    .map(|w| (format!("({:.3}, {:.3}, {:.3})", w.x, w.y, w.z), w))
+                    .collect(),
+            };
+            wis.into_iter()
+                .zip(0..)
+                .map(|((label, wi), k)| Job {
+                    name: format!("check-sampler/bsdf/wi={label}"),
+                    target: Target::Bsdf { wi },
+                    seeds: Seeds::Incident(k),
+                })
+                .collect()
+        }
+    })
 }
 
-/// The program's pdf at `points`, in batches.
-fn query<P: Coords>(
-    pipe: &mut Pipe,
-    domain: &str,
-    points: &[P],
-    batch: usize,
-    what: &str,
-) -> Result<Vec<f64>, String> {
-    let mut out = Vec::with_capacity(points.len());
-    for (k, chunk) in points.chunks(batch.max(1)).enumerate() {
-        let mut payload = Vec::with_capacity(chunk.len() * P::DIM);
-        for p in chunk {
-            p.write(&mut payload);
-        }
-        let head = json!({"phase": "pdf", "domain": domain, "count": chunk.len(), "dim": P::DIM});
-        let v = pipe.call(
-            head,
-            &payload,
-            chunk.len(),
-            1,
-            &format!("{what}, batch {k}"),
-        )?;
-        out.extend(v);
+/// A JSON direction [x, y, z] or a list of them, normalised.
+fn directions(v: &Value, key: &str) -> Result<Vec<Vec3>, String> {
+    let bad = || format!("--param {key}={v}: expected [x, y, z] or a list of them");
+    let one = |v: &Value| vec3(v).filter(|d| d.length() > 0.0).map(Vec3::normalize);
+    match one(v) {
+        Some(d) => Ok(vec![d]),
+        None => v
+            .as_array()
+            .filter(|a| !a.is_empty())
+            .ok_or_else(bad)?
+            .iter()
+            .map(|d| one(d).ok_or_else(bad))
+            .collect(),
     }
-    Ok(out)
+}
+
+fn vertices(v: &Value) -> Result<[Vec3; 3], String> {
+    let bad = || format!("--param vertices={v}: expected three points [[x,y,z],[x,y,z],[x,y,z]]");
+    let a = v.as_array().filter(|a| a.len() == 3).ok_or_else(bad)?;
+    let [a, b, c] = [vec3(&a[0]), vec3(&a[1]), vec3(&a[2])];
+    Ok([a.ok_or_else(bad)?, b.ok_or_else(bad)?, c.ok_or_else(bad)?])
+}
+
+/// A finite JSON point [x, y, z].
+fn vec3(v: &Value) -> Option<Vec3> {
+    let a = v.as_array().filter(|a| a.len() == 3)?;
+    let x: Vec<f32> = a
+        .iter()
+        .map(|x| x.as_f64().map(|x| x as f32))
+        .collect::<Option<_>>()?;
+    Some(Vec3::new(x[0], x[1], x[2])).filter(|p| p.is_finite())
 }

@@ -4,6 +4,7 @@
 //! `count x cols` f64. A reply that does not come within the timeout, a program that exits,
 //! a wrong count or a non-finite value is an error naming the phase and the batch.
 
+use super::program::{validate, Program};
 use serde_json::{json, Value};
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, ChildStdin, Command, Stdio};
@@ -58,17 +59,17 @@ impl Pipe {
             program: command.join(" "),
         })
     }
+}
 
-    /// Sends `header` with `payload` (rows of `dim` values) and returns the reply's `cols`
-    /// columns for each of the `rows` rows, all finite.
-    pub fn call(
+impl Program for Pipe {
+    fn call(
         &mut self,
         header: Value,
         payload: &[f64],
         rows: usize,
-        cols: usize,
+        cols: &[usize],
         what: &str,
-    ) -> Result<Vec<f64>, String> {
+    ) -> Result<(Vec<f64>, usize), String> {
         let fail = |why: String| format!("check-sampler: {what}: {why}");
         let mut bytes = serde_json::to_vec(&header).expect("json");
         bytes.push(b'\n');
@@ -122,26 +123,11 @@ impl Pipe {
                 None => e,
             })
         })?;
-        let count = head["count"].as_u64();
-        let got_cols = head["cols"].as_u64();
-        if count != Some(rows as u64) || got_cols != Some(cols as u64) {
-            return Err(fail(format!(
-                "expected a reply of {rows} rows x {cols} columns, got header {head}"
-            )));
-        }
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(fail(format!(
-                "non-finite value {} in row {}, column {}",
-                values[i],
-                i / cols,
-                i % cols
-            )));
-        }
-        Ok(values)
+        let c = validate(&head, &values, rows, cols).map_err(fail)?;
+        Ok((values, c))
     }
 
-    /// Tells the program to end and waits for it.
-    pub fn finish(mut self) {
+    fn finish(&mut self) {
         if let Some(mut s) = self.stdin.take() {
             let _ = s.write_all(format!("{}\n", json!({"phase": "end"})).as_bytes());
         }

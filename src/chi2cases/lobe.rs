@@ -16,7 +16,7 @@ use glam::{DVec3, Vec3};
 pub const WINDOW_BELOW_ALPHA: f32 = 0.2;
 
 /// Refinement depth in windows (cells / 2^6 at the support's edges).
-const WINDOW_MAX_DEPTH: u32 = 6;
+pub const WINDOW_MAX_DEPTH: u32 = 6;
 
 /// Slopes out to this many alphas are inside the window (Beckmann: all but e^-16 of the
 /// normals; GGX: all but 1/17, its tail then goes to the lost category).

@@ -19,6 +19,7 @@ pub mod emitters;
 pub mod exact;
 pub mod lobe;
 pub mod probe;
+pub mod protocol;
 pub mod scene;
 pub mod tangent;
 pub mod warps;
@@ -139,6 +140,9 @@ pub struct Case {
     pub name: String,
     /// One line saying what is sampled, from where.
     pub about: String,
+    /// What an outside program is asked to sample in this case's place (`check-sampler
+    /// --case`), when the case has a protocol form.
+    pub external: Option<protocol::Target>,
     run: Box<RunFn>,
 }
 
@@ -151,8 +155,15 @@ impl Case {
         Case {
             name: name.into(),
             about: about.into(),
+            external: None,
             run: Box::new(run),
         }
+    }
+
+    /// The case with a protocol form (see [`protocol`]).
+    pub fn with_external(mut self, target: protocol::Target) -> Case {
+        self.external = Some(target);
+        self
     }
 
     /// A sampler of points of `domain(cfg)` against its pdf, plus the integral check.
@@ -178,12 +189,21 @@ impl Case {
     /// Runs the case on its own random stream, derived from `cfg.seed` and the case's name,
     /// so that the cases of a run are independent (as the Sidak correction assumes).
     pub fn run(&self, cfg: &CaseConfig) -> Outcome {
-        let seed = self
-            .name
-            .bytes()
-            .fold(mix64(cfg.seed), |h, b| mix64(h ^ b as u64));
-        (self.run)(&CaseConfig { seed, ..*cfg })
+        (self.run)(&CaseConfig {
+            seed: self.seed(cfg.seed),
+            ..*cfg
+        })
     }
+
+    /// The seed of the case's own random stream in a run of seed `seed`.
+    pub fn seed(&self, seed: u64) -> u64 {
+        case_seed(&self.name, seed)
+    }
+}
+
+/// The seed of the stream of the case named `name` in a run of seed `seed`.
+pub fn case_seed(name: &str, seed: u64) -> u64 {
+    name.bytes().fold(mix64(seed), |h, b| mix64(h ^ b as u64))
 }
 
 /// Tests a sampler against a pdf: chi-square and the integral check at `sidak(alpha, 2)`

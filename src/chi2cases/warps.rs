@@ -5,7 +5,7 @@
 
 use super::bsdfs;
 use super::lobe::{normal_window, run_windowed};
-use super::tangent::Tangent;
+use super::protocol::{cone_window, disk, spherical_triangle_window, triangle, Target};
 use super::{Case, CaseConfig};
 use crate::analytic::triangle_solid_angle;
 use crate::geometry::watertight::intersect_triangle;
@@ -13,25 +13,13 @@ use crate::rng::Rng;
 use crate::sampling::microfacet::{Microfacet, MicrofacetDistribution};
 use crate::sampling::spherical::sample_spherical_triangle;
 use crate::sampling::warps::*;
-use crate::stats::{Disk, Triangle};
 use glam::{DVec3, Vec2, Vec3};
-
-fn disk(cfg: &CaseConfig) -> Disk {
-    let r = cfg.resolution.max(2);
-    Disk { n_phi: r, n_r2: r }
-}
-
-fn triangle(cfg: &CaseConfig) -> Triangle {
-    Triangle {
-        n: cfg.resolution.max(2),
-    }
-}
 
 const CONE_WIDE: f32 = 0.3;
 const CONE_NARROW: f32 = 0.999;
 
 /// A triangle seen from the origin that covers ~0.6 sr, tilted so its edges cut cells.
-fn spherical_triangle_vertices() -> [Vec3; 3] {
+pub fn spherical_triangle_vertices() -> [Vec3; 3] {
     [
         Vec3::new(-0.6, -0.4, 1.0),
         Vec3::new(0.7, -0.2, 1.3),
@@ -43,13 +31,11 @@ fn spherical_triangle_case() -> Case {
     let v = spherical_triangle_vertices();
     let [a, b, c] = v.map(|p| p.as_dvec3());
     let omega = triangle_solid_angle(DVec3::ZERO, a, b, c);
-    let dirs: Vec<DVec3> = [a, b, c].iter().map(|p| p.normalize()).collect();
-    let axis = dirs.iter().sum::<DVec3>();
     Case::new(
         "warp/spherical-triangle",
         format!("uniform direction in a triangle of {omega:.3} sr (Arvo), pdf 1/Omega"),
         move |cfg| {
-            let w = Tangent::fit(axis, &dirs, cfg.resolution);
+            let w = spherical_triangle_window(&v, cfg.resolution);
             let pdf = w.plane_pdf(|d| {
                 let hit = intersect_triangle(Vec3::ZERO, d, 0.0, f32::INFINITY, v).is_some();
                 if hit {
@@ -63,20 +49,23 @@ fn spherical_triangle_case() -> Case {
             super::run_continuous("warp/spherical-triangle", &w, sampler, pdf, cfg, vec![])
         },
     )
+    .with_external(Target::SphericalTriangle { vertices: v })
 }
 
 fn narrow_cone_case() -> Case {
-    let half = (CONE_NARROW as f64).acos() * 1.02;
     Case::new(
         "warp/uniform-cone-narrow",
         format!("uniform cone, cos(theta_max) = {CONE_NARROW}, in a window around its axis"),
         move |cfg| {
-            let w = Tangent::cone(DVec3::Z, half, cfg.resolution);
+            let w = cone_window(CONE_NARROW, cfg.resolution);
             let pdf = w.plane_pdf(|d| square_to_uniform_cone_pdf(d, CONE_NARROW) as f64);
             let sampler = |r: &mut Rng| Some(square_to_uniform_cone(r.next_2d(), CONE_NARROW));
             super::run_continuous("warp/uniform-cone-narrow", &w, sampler, pdf, cfg, vec![])
         },
     )
+    .with_external(Target::Cap {
+        cos_theta_max: CONE_NARROW,
+    })
 }
 
 pub fn cases() -> Vec<Case> {
@@ -88,56 +77,66 @@ pub fn cases() -> Vec<Case> {
             disk,
             |r: &mut Rng| Some(square_to_uniform_disk(r.next_2d())),
             move |p| f(square_to_uniform_disk_pdf(p)),
-        ),
+        )
+        .with_external(Target::Disk),
         Case::continuous(
             "warp/concentric-disk",
             "Shirley-Chiu concentric map, pdf 1/pi",
             disk,
             |r: &mut Rng| Some(square_to_concentric_disk(r.next_2d())),
             move |p| f(square_to_uniform_disk_pdf(p)),
-        ),
+        )
+        .with_external(Target::Disk),
         Case::continuous(
             "warp/tent",
             "separable tent on [-1,1]^2, mapped onto the unit square",
             |c: &CaseConfig| c.square(),
             |r: &mut Rng| Some((square_to_tent(r.next_2d()) + Vec2::ONE) * 0.5),
             move |p: Vec2| 4.0 * f(square_to_tent_pdf(p * 2.0 - Vec2::ONE)),
-        ),
+        )
+        .with_external(Target::Square),
         Case::continuous(
             "warp/uniform-triangle",
             "square-root barycentrics, pdf 2 on the unit right triangle",
             triangle,
             |r: &mut Rng| Some(square_to_uniform_triangle(r.next_2d())),
             move |p| f(square_to_uniform_triangle_pdf(p)),
-        ),
+        )
+        .with_external(Target::Triangle),
         Case::continuous(
             "warp/uniform-sphere",
             "uniform direction, pdf 1/(4 pi)",
             |c: &CaseConfig| c.sphere(),
             |r: &mut Rng| Some(square_to_uniform_sphere(r.next_2d())),
             move |d| f(square_to_uniform_sphere_pdf(d)),
-        ),
+        )
+        .with_external(Target::Sphere),
         Case::continuous(
             "warp/uniform-hemisphere",
             "uniform direction with z > 0, pdf 1/(2 pi)",
             |c: &CaseConfig| c.sphere(),
             |r: &mut Rng| Some(square_to_uniform_hemisphere(r.next_2d())),
             move |d| f(square_to_uniform_hemisphere_pdf(d)),
-        ),
+        )
+        .with_external(Target::Hemisphere),
         Case::continuous(
             "warp/cosine-hemisphere",
             "concentric disk lifted to the hemisphere, pdf cos(theta)/pi",
             |c: &CaseConfig| c.sphere(),
             |r: &mut Rng| Some(square_to_cosine_hemisphere(r.next_2d())),
             move |d| f(square_to_cosine_hemisphere_pdf(d)),
-        ),
+        )
+        .with_external(Target::Hemisphere),
         Case::continuous(
             "warp/uniform-cone-wide",
             format!("uniform cone, cos(theta_max) = {CONE_WIDE}, on the whole sphere"),
             |c: &CaseConfig| c.sphere(),
             |r: &mut Rng| Some(square_to_uniform_cone(r.next_2d(), CONE_WIDE)),
             move |d| f(square_to_uniform_cone_pdf(d, CONE_WIDE)),
-        ),
+        )
+        .with_external(Target::Cap {
+            cos_theta_max: CONE_WIDE,
+        }),
         narrow_cone_case(),
         spherical_triangle_case(),
     ];
@@ -159,21 +158,27 @@ pub fn microfacet_cases() -> Vec<Case> {
             let mf = Microfacet::new(d, a.0, a.1);
             let name = format!("warp/{dn}-{}-dcos", bsdfs::alpha_name(a));
             let label = name.clone();
-            v.push(Case::new(
-                name,
-                format!("{dn} normals, density D(m) cos(theta_m), alpha {a:?}"),
-                move |cfg| {
-                    let window = normal_window(a, cfg.resolution);
-                    run_windowed(
-                        &label,
-                        window,
-                        |r| Some(mf.sample_all(r.next_2d())),
-                        |m| mf.pdf_all(m) as f64,
-                        cfg,
-                        vec![],
-                    )
-                },
-            ));
+            v.push(
+                Case::new(
+                    name,
+                    format!("{dn} normals, density D(m) cos(theta_m), alpha {a:?}"),
+                    move |cfg| {
+                        let window = normal_window(a, cfg.resolution);
+                        run_windowed(
+                            &label,
+                            window,
+                            |r| Some(mf.sample_all(r.next_2d())),
+                            |m| mf.pdf_all(m) as f64,
+                            cfg,
+                            vec![],
+                        )
+                    },
+                )
+                .with_external(Target::Normals {
+                    distribution: d,
+                    alpha: a,
+                }),
+            );
             for (wname, wi) in bsdfs::incident().into_iter().filter(|(_, w)| w.z > 0.0) {
                 let name = format!("warp/{dn}-{}-vndf-{wname}", bsdfs::alpha_name(a));
                 let label = name.clone();

@@ -1,0 +1,356 @@
+//! One check of a program's sampler on one target: the three phases of the protocol and the
+//! statistics of directlab's own chi-square cases.
+//!
+//! 1. **sample**: rows of uniform numbers (drawn as the built-in cases draw them: f32 values
+//!    of `Rng::new(seed, 0)`, so a program implementing a built-in warp gets its p-value)
+//!    come back as point, claimed pdf, valid flag (0: sampling failed) and optional weights.
+//! 2. **pdf**: at every valid sample (the claimed pdf must be pdf(point)), then at the nodes
+//!    of the adaptive cell integration, one batch per refinement level
+//!    ([`crate::stats::integrate_batched`]), so support edges are refined where they are.
+//! 3. **eval** (BSDFs): f cos at the samples, so weight == f cos / pdf is checked sample by
+//!    sample, and over the domain's cells, so the mean weight can be held against the
+//!    albedo (white furnace: no more than 1, and all of it reached by the sampler).
+
+use super::program::Program;
+use crate::chi2cases::checks::{z_critical, WeightCheck};
+use crate::chi2cases::protocol::{AnyDomain, Target};
+use crate::chi2cases::tangent::Tangent;
+use crate::chi2cases::{run_given, CaseConfig, Check, Outcome};
+use crate::stats::integrate_batched::integrate_rects_batched;
+use crate::stats::{Domain, Grid, Welford};
+use glam::{Vec2, Vec3};
+use serde_json::{json, Value};
+use std::cell::RefCell;
+
+/// A point's coordinates as f64, in and out of the protocol.
+pub trait Coords: Copy {
+    const DIM: usize;
+    fn read(v: &[f64]) -> Self;
+    fn write(self, out: &mut Vec<f64>);
+}
+
+impl Coords for Vec2 {
+    const DIM: usize = 2;
+    fn read(v: &[f64]) -> Self {
+        Vec2::new(v[0] as f32, v[1] as f32)
+    }
+    fn write(self, out: &mut Vec<f64>) {
+        out.extend([self.x as f64, self.y as f64]);
+    }
+}
+
+impl Coords for Vec3 {
+    const DIM: usize = 3;
+    fn read(v: &[f64]) -> Self {
+        Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
+    }
+    fn write(self, out: &mut Vec<f64>) {
+        out.extend([self.x as f64, self.y as f64, self.z as f64]);
+    }
+}
+
+/// How one check talks to the program.
+pub struct Session<'a> {
+    pub program: &'a mut dyn Program,
+    pub target: &'a Target,
+    /// Sent with every request: the target's parameters and the user's `--param`s.
+    pub params: Value,
+    /// Uniform numbers per sample.
+    pub dims: usize,
+    /// Rows per request.
+    pub batch: usize,
+    /// The cell masses and the albedo, once integrated: they do not depend on the seed.
+    pub integrals: Option<(Grid, f64)>,
+}
+
+/// Checks the program on `s.target`, named `name` in the outcome.
+pub fn check(s: &mut Session, cfg: &CaseConfig, name: &str) -> Result<Outcome, String> {
+    match s.target.domain(cfg) {
+        AnyDomain::Square(d) => check_on(s, cfg, name, &d, |_| true, |_| 1.0),
+        AnyDomain::Disk(d) => check_on(s, cfg, name, &d, |_| true, |_| 1.0),
+        AnyDomain::Triangle(d) => check_on(s, cfg, name, &d, |_| true, |_| 1.0),
+        AnyDomain::Sphere(d) => check_on(s, cfg, name, &d, |_| true, |_| 1.0),
+        AnyDomain::Window(w) => check_on(
+            s,
+            cfg,
+            name,
+            &w,
+            |p| w.locate(p).is_ok(),
+            |p| plane_factor(&w, p),
+        ),
+    }
+}
+
+/// dω / (dx dy) in a tangent-plane window: cos³ of the angle to its axis.
+fn plane_factor(w: &Tangent, d: Vec3) -> f64 {
+    let c = d.as_dvec3().normalize().dot(w.axis());
+    if c > 0.0 {
+        c * c * c
+    } else {
+        0.0
+    }
+}
+
+fn check_on<D>(
+    s: &mut Session,
+    cfg: &CaseConfig,
+    name: &str,
+    domain: &D,
+    keep: impl Fn(D::Point) -> bool,
+    measure: impl Fn(D::Point) -> f64,
+) -> Result<Outcome, String>
+where
+    D: Domain,
+    D::Point: Coords,
+{
+    let pdim = D::Point::DIM;
+    let bsdf = matches!(s.target, Target::Bsdf { .. });
+    // 1. Samples, from uniform numbers drawn here.
+    let mut rng = crate::rng::Rng::new(cfg.seed, 0);
+    let n_all = cfg.samples as usize;
+    let mut points: Vec<Option<D::Point>> = Vec::with_capacity(n_all);
+    let (mut claimed, mut weights) = (Vec::new(), Vec::new());
+    let mut wcols = 0;
+    let (mut left, mut k) = (n_all, 0);
+    while left > 0 {
+        let n = left.min(s.batch);
+        let u: Vec<f64> = (0..s.dims * n).map(|_| rng.next_f32() as f64).collect();
+        let what = format!("sample phase, batch {k}");
+        let allowed = [pdim + 2, pdim + 3, pdim + 5];
+        let (v, cols) = request(s, "sample", &u, n, s.dims, &allowed, &what)?;
+        wcols = cols - pdim - 2;
+        for row in v.chunks_exact(cols) {
+            let valid = row[pdim + 1] > 0.5;
+            points.push(valid.then(|| D::Point::read(&row[..pdim])));
+            if valid {
+                claimed.push(row[pdim]);
+                weights.push(max_channel(&row[pdim + 2..]));
+            }
+        }
+        left -= n;
+        k += 1;
+    }
+    // 2. The pdf at the samples themselves (and f cos there, for a BSDF).
+    let valid: Vec<D::Point> = points.iter().flatten().copied().collect();
+    let at_samples = query(s, "pdf", &valid, &[1], "pdf phase at the samples")?;
+    let mut checks = vec![claim_check(&claimed, &at_samples)];
+    if bsdf {
+        let evals = query(s, "eval", &valid, &[1, 3], "eval phase at the samples")?;
+        let mut furnace = Welford::new();
+        let mut wc = WeightCheck::default();
+        for i in 0..valid.len() {
+            let w = if wcols > 0 {
+                weights[i]
+            } else {
+                evals[i] / claimed[i]
+            };
+            if wcols > 0 {
+                wc.record(w, evals[i], claimed[i], at_samples[i]);
+            }
+            furnace.push(w);
+        }
+        for _ in valid.len()..n_all {
+            furnace.push(0.0);
+        }
+        // Nothing sampled (lit from below a one-sided BSDF) has no weight to check.
+        if wcols > 0 && !valid.is_empty() {
+            checks.push(wc.check());
+        }
+        let albedo = integrals(s, cfg, domain, &measure, bsdf)?.1;
+        checks.extend(furnace_checks(&furnace, albedo, cfg.alpha));
+    }
+    // 3. Cell masses from the adaptive integration, then the chi-square test.
+    let grid = integrals(s, cfg, domain, &measure, bsdf)?.0;
+    let queue = RefCell::new(points.into_iter());
+    let mut o = run_given(
+        name,
+        domain,
+        |_| queue.borrow_mut().next().flatten().filter(|p| keep(*p)),
+        &grid,
+        cfg,
+    );
+    o.checks.extend(checks);
+    Ok(o)
+}
+
+fn max_channel(v: &[f64]) -> f64 {
+    v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// The claimed pdf of every valid sample equals the program's pdf() there.
+fn claim_check(claimed: &[f64], at_samples: &[f64]) -> Check {
+    let mismatch: Vec<(usize, f64, f64)> = claimed
+        .iter()
+        .zip(at_samples)
+        .enumerate()
+        .filter(|(_, (c, p))| (*c - *p).abs() > 1e-5 * c.abs().max(p.abs()).max(1e-300))
+        .map(|(i, (c, p))| (i, *c, *p))
+        .collect();
+    Check {
+        name: "claimed pdf",
+        passed: mismatch.is_empty(),
+        detail: match mismatch.first() {
+            None => format!(
+                "the pdf at all {} samples equals the pdf claimed with them",
+                claimed.len()
+            ),
+            Some(&(i, c, p)) => format!(
+                "{} of {} samples claim a pdf other than pdf(point): sample {i} claims {c:e}, \
+                 pdf gives {p:e}",
+                mismatch.len(),
+                claimed.len()
+            ),
+        },
+    }
+}
+
+/// Energy a white-furnace test is allowed beyond 1: the integration's own error.
+const ALBEDO_TOL: f64 = 1e-3;
+
+/// The mean weight estimates the part of the albedo the sampler reaches; it must be all of
+/// it (a z-test at `alpha`), and the albedo no more than 1.
+fn furnace_checks(w: &Welford, albedo: f64, alpha: f64) -> [Check; 2] {
+    let (mean, se) = (w.mean(), w.std_error());
+    let bound = z_critical(alpha) * se + ALBEDO_TOL * albedo.max(mean);
+    [
+        Check {
+            name: "furnace",
+            passed: (mean - albedo).abs() <= bound,
+            detail: format!(
+                "mean weight {mean:.5} (standard error {se:.1e}) against the albedo \
+                 {albedo:.5} integrated from eval (allowed difference {bound:.1e})"
+            ),
+        },
+        Check {
+            name: "energy",
+            passed: albedo <= 1.0 + ALBEDO_TOL,
+            detail: format!("albedo (integral of f cos) {albedo:.5}, at most 1"),
+        },
+    ]
+}
+
+/// The cell masses of the pdf and the albedo (when `bsdf`), from the session's cache.
+fn integrals<D>(
+    s: &mut Session,
+    cfg: &CaseConfig,
+    domain: &D,
+    measure: &impl Fn(D::Point) -> f64,
+    bsdf: bool,
+) -> Result<(Grid, f64), String>
+where
+    D: Domain,
+    D::Point: Coords,
+{
+    if s.integrals.is_none() {
+        let albedo = match bsdf {
+            true => integrate(s, cfg, domain, measure, "eval", &[1, 3])?.sum(),
+            false => f64::NAN,
+        };
+        let grid = integrate(s, cfg, domain, measure, "pdf", &[1])?;
+        s.integrals = Some((grid, albedo));
+    }
+    Ok(s.integrals.clone().expect("just set"))
+}
+
+/// The integral over each cell of the program's `phase` ("pdf" or "eval", channel maximum),
+/// times `measure` (the density's measure per du dv).
+fn integrate<D>(
+    s: &mut Session,
+    cfg: &CaseConfig,
+    domain: &D,
+    measure: &impl Fn(D::Point) -> f64,
+    phase: &str,
+    cols: &[usize],
+) -> Result<Grid, String>
+where
+    D: Domain,
+    D::Point: Coords,
+{
+    let (ncol, nrow) = domain.resolution();
+    let ([u0, u1], [v0, v1]) = domain.bounds();
+    let (du, dv) = ((u1 - u0) / ncol as f64, (v1 - v0) / nrow as f64);
+    let rects: Vec<([f64; 2], [f64; 2])> = (0..nrow * ncol)
+        .map(|c| {
+            let (i, j) = ((c % ncol) as f64, (c / ncol) as f64);
+            (
+                [u0 + i * du, u0 + (i + 1.0) * du],
+                [v0 + j * dv, v0 + (j + 1.0) * dv],
+            )
+        })
+        .collect();
+    let mut failure = None;
+    let mut level = 0;
+    let jac = domain.jacobian();
+    let data = integrate_rects_batched(
+        &rects,
+        &mut |uv: &[[f64; 2]]| {
+            let pts: Vec<Option<D::Point>> = uv.iter().map(|p| domain.point(p[0], p[1])).collect();
+            let send: Vec<D::Point> = pts.iter().flatten().copied().collect();
+            let what = format!("{phase} phase, integration level {level}");
+            level += 1;
+            let got = match failure {
+                Some(_) => Ok(vec![0.0; send.len()]),
+                None => query(s, phase, &send, cols, &what),
+            };
+            let got = got.unwrap_or_else(|e| {
+                failure = Some(e);
+                vec![0.0; send.len()]
+            });
+            let mut it = got.into_iter();
+            pts.iter()
+                .map(|p| p.map_or(0.0, |p| it.next().unwrap_or(0.0) * jac * measure(p)))
+                .collect()
+        },
+        &cfg.integration,
+        1e-9 / (nrow * ncol) as f64,
+    );
+    match failure {
+        Some(e) => Err(e),
+        None => Ok(Grid {
+            cols: ncol,
+            rows: nrow,
+            data,
+        }),
+    }
+}
+
+/// The program's `phase` ("pdf" or "eval") at `points`, in batches; one value per point (the
+/// channel maximum of a colour).
+fn query<P: Coords>(
+    s: &mut Session,
+    phase: &str,
+    points: &[P],
+    cols: &[usize],
+    what: &str,
+) -> Result<Vec<f64>, String> {
+    let mut out = Vec::with_capacity(points.len());
+    for (k, chunk) in points.chunks(s.batch.max(1)).enumerate() {
+        let mut payload = Vec::with_capacity(chunk.len() * P::DIM);
+        for p in chunk {
+            p.write(&mut payload);
+        }
+        let what = format!("{what}, batch {k}");
+        let (v, c) = request(s, phase, &payload, chunk.len(), P::DIM, cols, &what)?;
+        out.extend(v.chunks_exact(c).map(max_channel));
+    }
+    Ok(out)
+}
+
+fn request(
+    s: &mut Session,
+    phase: &str,
+    payload: &[f64],
+    rows: usize,
+    dim: usize,
+    cols: &[usize],
+    what: &str,
+) -> Result<(Vec<f64>, usize), String> {
+    let head = json!({
+        "phase": phase,
+        "domain": s.target.name(),
+        "count": rows,
+        "dim": dim,
+        "params": s.params,
+    });
+    s.program.call(head, payload, rows, cols, what)
+}
