@@ -4,6 +4,8 @@
 //! integration and the statistics ([`engine`]).
 
 pub mod engine;
+pub mod files;
+pub mod npy;
 pub mod pipe;
 pub mod program;
 #[cfg(test)]
@@ -14,6 +16,7 @@ use crate::chi2cases::protocol::Target;
 use crate::chi2cases::{CaseConfig, Check, Outcome};
 use crate::limits::Bound;
 use crate::sampling::microfacet::MicrofacetDistribution;
+use files::Files;
 use glam::Vec3;
 use pipe::Pipe;
 use program::Program;
@@ -57,6 +60,13 @@ pub enum DomainKind {
     Bsdf,
 }
 
+/// See `--transport`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Transport {
+    Pipe,
+    Files,
+}
+
 #[derive(clap::Args, Debug)]
 pub struct CheckSamplerArgs {
     /// What the program samples.
@@ -88,8 +98,15 @@ pub struct CheckSamplerArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Rows per message to the program.
-    #[arg(long, default_value_t = 65_536, value_parser = crate::limits::parser("--batch", 1, BATCH))]
-    pub batch: u64,
+    /// (Default: 65,536 through a pipe; the largest allowed for files, where every request
+    /// starts the program anew.)
+    #[arg(long, value_parser = crate::limits::parser("--batch", 1, BATCH))]
+    pub batch: Option<u64>,
+    /// How requests reach the program: `pipe` (one process, requests on its stdin) or
+    /// `files` (the program is run once per request with the path of a JSON request file
+    /// whose "input" and "output" are .npy files; for batch jobs and graders).
+    #[arg(long, value_enum, default_value_t = Transport::Pipe)]
+    pub transport: Transport,
     /// Seconds to wait for each reply before the program is killed.
     #[arg(long, default_value_t = 60.0)]
     pub timeout: f64,
@@ -182,7 +199,11 @@ pub fn run(a: &CheckSamplerArgs) -> Result<Report, String> {
     }
     let params = parse_params(&a.params)?;
     let jobs = jobs(a, &params)?;
-    let mut pipe = Pipe::start(&a.command, Duration::from_secs_f64(a.timeout))?;
+    let timeout = Duration::from_secs_f64(a.timeout);
+    let mut program: Box<dyn Program> = match a.transport {
+        Transport::Pipe => Box::new(Pipe::start(&a.command, timeout)?),
+        Transport::Files => Box::new(Files::new(&a.command, a.out.join("requests"), timeout)?),
+    };
     // The run as a whole is at --alpha: each check at the Sidak level over all of them.
     let runs = jobs.len() * a.seeds as usize;
     let alpha = crate::stats::sidak(a.alpha, runs);
@@ -194,11 +215,14 @@ pub fn run(a: &CheckSamplerArgs) -> Result<Report, String> {
             m.extend(params.clone());
         }
         let mut session = engine::Session {
-            program: &mut pipe,
+            program: program.as_mut(),
             target: &job.target,
             params: sent,
             dims: a.dims as usize,
-            batch: a.batch as usize,
+            batch: a.batch.unwrap_or(match a.transport {
+                Transport::Pipe => 65_536,
+                Transport::Files => BATCH.max,
+            }) as usize,
             integrals: None,
         };
         let mut p_values = Vec::new();
@@ -223,7 +247,7 @@ pub fn run(a: &CheckSamplerArgs) -> Result<Report, String> {
             calibration.push((job.name.clone(), uniformity(p_values, level)));
         }
     }
-    pipe.finish();
+    program.finish();
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
     let mut out = Vec::new();
     for (k, o) in outcomes.into_iter().enumerate() {

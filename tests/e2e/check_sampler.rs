@@ -252,3 +252,35 @@ fn bad_cases_and_parameters_are_named() {
         assert!(!ok && text.contains(words), "{args:?}: {text}");
     }
 }
+
+#[test]
+fn the_files_transport_gives_the_pipes_result_and_names_bad_replies() {
+    if !numpy() {
+        return;
+    }
+    let example = repo("examples/samplers/directlab_warps.py");
+    let prog = ["python3", example.to_str().unwrap(), "cosine-hemisphere"];
+    let args = ["--case", "warp/cosine-hemisphere", "--samples", "50000"];
+    let (ok_pipe, pipe) = check_with(&args, &prog);
+    let mut files_args = args.to_vec();
+    files_args.extend(["--transport", "files"]);
+    let (ok_files, files) = check_with(&files_args, &prog);
+    assert!(ok_pipe && ok_files, "{pipe}\n{files}");
+    assert_eq!(
+        number_after(&pipe, "chi2 = "),
+        number_after(&files, "chi2 = "),
+        "{pipe}\n{files}"
+    );
+    // A program that fails, one that writes nothing, one that writes float32.
+    let f32_reply = "import sys, json, numpy as np; h = json.load(open(sys.argv[-1])); \
+        np.save(h['output'], np.zeros((h['count'], 5), dtype='<f4'))";
+    for (program, words) in [
+        ("import sys; sys.exit(4)", "exited: exit status: 4"),
+        ("pass", "finished without writing"),
+        (f32_reply, "expected little-endian float64 ('<f8')"),
+    ] {
+        let (ok, text) = check_with(&files_args, &["python3", "-c", program]);
+        assert!(!ok && text.contains(words), "{program}: {text}");
+        assert!(text.contains("sample phase, batch 0"), "{text}");
+    }
+}
