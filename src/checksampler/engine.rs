@@ -350,6 +350,7 @@ fn request(
         "domain": s.target.name(),
         "count": rows,
         "dim": dim,
+        "point_dim": s.target.dim(),
         "params": s.params,
     });
     s.program.call(head, payload, rows, cols, what)

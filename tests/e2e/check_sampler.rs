@@ -39,7 +39,7 @@ fn check(extra: &[&str], program: &[&str]) -> (bool, String) {
     check_with(&args, program)
 }
 
-fn check_with(args: &[&str], program: &[&str]) -> (bool, String) {
+pub(crate) fn check_with(args: &[&str], program: &[&str]) -> (bool, String) {
     static RUN: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let k = RUN.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
     let out = scratch(&format!("check-sampler-{k}"));
@@ -110,7 +110,7 @@ fn misbehaving_programs_end_in_errors_naming_the_phase() {
 }
 
 /// The number after `key` in `text` (up to the next comma, semicolon or space).
-fn number_after(text: &str, key: &str) -> f64 {
+pub(crate) fn number_after(text: &str, key: &str) -> f64 {
     let at = text
         .find(key)
         .unwrap_or_else(|| panic!("no '{key}' in {text}"))
@@ -123,13 +123,38 @@ fn number_after(text: &str, key: &str) -> f64 {
 }
 
 /// (case, the example's warp argument)
-const WARPS: [(&str, &str); 5] = [
+pub(crate) const WARPS: [(&str, &str); 5] = [
     ("warp/uniform-disk", "uniform-disk"),
     ("warp/cosine-hemisphere", "cosine-hemisphere"),
     ("warp/spherical-triangle", "spherical-triangle"),
     ("warp/beckmann-a0.5-dcos", "beckmann"),
     ("warp/beckmann-a0.01-dcos", "beckmann"),
 ];
+
+/// The p-value of a built-in case at seed 0 (`directlab chi2`), run once per case and size
+/// whichever test asks first.
+pub(crate) fn builtin_p_value(case: &str, samples: u64) -> f64 {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+    static DONE: OnceLock<Mutex<HashMap<(String, u64), f64>>> = OnceLock::new();
+    let mut done = DONE.get_or_init(Default::default).lock().unwrap();
+    if let Some(p) = done.get(&(case.to_string(), samples)) {
+        return *p;
+    }
+    let out = scratch(&format!("check-sampler-builtin-{}", case.replace('/', "-")));
+    let o = run(directlab()
+        .args(["chi2", case, "--samples", &samples.to_string(), "--out"])
+        .arg(&out));
+    assert!(o.status.success(), "{case}: {o:?}");
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let row = csv
+        .lines()
+        .find(|l| l.starts_with(&format!("{case},")))
+        .unwrap();
+    let p = row.split(',').nth(7).unwrap().parse().unwrap();
+    done.insert((case.to_string(), samples), p);
+    p
+}
 
 #[test]
 fn directlab_warps_in_python_get_the_built_in_p_values() {
@@ -144,17 +169,7 @@ fn directlab_warps_in_python_get_the_built_in_p_values() {
         );
         assert!(ok, "{case}: {text}");
         let p_program = number_after(&text, "p = ");
-        let out = scratch(&format!("check-sampler-builtin-{}", warp));
-        let o = run(directlab()
-            .args(["chi2", case, "--samples", "100000", "--out"])
-            .arg(&out));
-        assert!(o.status.success(), "{case}: {o:?}");
-        let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
-        let row = csv
-            .lines()
-            .find(|l| l.starts_with(&format!("{case},")))
-            .unwrap();
-        let p_builtin: f64 = row.split(',').nth(7).unwrap().parse().unwrap();
+        let p_builtin = builtin_p_value(case, 100_000);
         // The same points in the same cells: only the cell integration (batched through
         // the program's pdf, or recursive on directlab's) may move the statistic a little.
         assert!(

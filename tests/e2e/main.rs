@@ -9,6 +9,7 @@ mod bad_input;
 mod bench_cli;
 mod browser;
 mod check_sampler;
+mod check_sampler_cpp;
 mod experiment_cli;
 mod extreme;
 mod html_page;
