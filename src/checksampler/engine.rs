@@ -16,7 +16,10 @@ use crate::chi2cases::checks::{z_critical, WeightCheck};
 use crate::chi2cases::protocol::{AnyDomain, Target};
 use crate::chi2cases::tangent::Tangent;
 use crate::chi2cases::{run_given, CaseConfig, Check, Outcome};
-use crate::stats::integrate_batched::integrate_rects_batched;
+use crate::stats::integrate_batched::{
+    boundary_pass_batched, integrate_rects_batched, integrate_rects_trapezoid, recheck_batched,
+};
+use crate::stats::Integration;
 use crate::stats::{Domain, Grid, Welford};
 use glam::{Vec2, Vec3};
 use serde_json::{json, Value};
@@ -61,6 +64,9 @@ pub struct Session<'a> {
     pub batch: usize,
     /// The cell masses and the albedo, once integrated: they do not depend on the seed.
     pub integrals: Option<(Grid, f64)>,
+    /// Integrate each cell by a fixed trapezoid of this many intervals a side, as Mitsuba's
+    /// `ChiSquareTest` does with `ires` (to compare; adaptive when None).
+    pub ires: Option<usize>,
 }
 
 /// Checks the program on `s.target`, named `name` in the outcome.
@@ -132,6 +138,13 @@ where
     }
     // 2. The pdf at the samples themselves (and f cos there, for a BSDF).
     let valid: Vec<D::Point> = points.iter().flatten().copied().collect();
+    let (ncol, nrow) = domain.resolution();
+    let mut seen = Grid::new(ncol, nrow);
+    for p in valid.iter().filter(|p| keep(**p)) {
+        if let Ok((c, r)) = domain.cell_of(*p) {
+            seen.data[r * ncol + c] += 1.0;
+        }
+    }
     let at_samples = query(s, "pdf", &valid, &[1], "pdf phase at the samples")?;
     let mut checks = vec![claim_check(&claimed, &at_samples)];
     if bsdf {
@@ -156,11 +169,11 @@ where
         if wcols > 0 && !valid.is_empty() {
             checks.push(wc.check());
         }
-        let albedo = integrals(s, cfg, domain, &measure, bsdf)?.1;
+        let albedo = integrals(s, cfg, domain, &measure, bsdf, &seen)?.1;
         checks.extend(furnace_checks(&furnace, albedo, cfg.alpha));
     }
     // 3. Cell masses from the adaptive integration, then the chi-square test.
-    let grid = integrals(s, cfg, domain, &measure, bsdf)?.0;
+    let grid = integrals(s, cfg, domain, &measure, bsdf, &seen)?.0;
     let queue = RefCell::new(points.into_iter());
     let mut o = run_given(
         name,
@@ -229,88 +242,158 @@ fn furnace_checks(w: &Welford, albedo: f64, alpha: f64) -> [Check; 2] {
     ]
 }
 
-/// The cell masses of the pdf and the albedo (when `bsdf`), from the session's cache.
+/// The cell masses of the pdf and the albedo (when `bsdf`). Both are integrated once per
+/// session (they do not depend on the seed); cells that this seed's samples (`seen`)
+/// reached but whose mass is 0 are looked at again every time.
 fn integrals<D>(
     s: &mut Session,
     cfg: &CaseConfig,
     domain: &D,
     measure: &impl Fn(D::Point) -> f64,
     bsdf: bool,
+    seen: &Grid,
 ) -> Result<(Grid, f64), String>
 where
     D: Domain,
     D::Point: Coords,
 {
-    if s.integrals.is_none() {
-        let albedo = match bsdf {
-            true => integrate(s, cfg, domain, measure, "eval", &[1, 3])?.sum(),
-            false => f64::NAN,
-        };
-        let grid = integrate(s, cfg, domain, measure, "pdf", &[1])?;
-        s.integrals = Some((grid, albedo));
+    let cells = Cells::of(domain);
+    let fixed = s.ires;
+    let integration = cfg.integration;
+    let (mut grid, albedo) = match s.integrals.take() {
+        Some(known) => known,
+        None => {
+            let albedo = match bsdf {
+                true => nodes(s, domain, measure, "eval", &[1, 3], |f| {
+                    cells.integrate(f, &integration, fixed)
+                })?
+                .sum(),
+                false => f64::NAN,
+            };
+            let grid = nodes(s, domain, measure, "pdf", &[1], |f| {
+                cells.integrate(f, &integration, fixed)
+            })?;
+            (grid, albedo)
+        }
+    };
+    if fixed.is_none() {
+        nodes(s, domain, measure, "pdf", &[1], |f| {
+            recheck_batched(
+                &mut grid,
+                &|c, r| cells.rect(c, r),
+                f,
+                &integration,
+                cells.tol,
+                seen,
+            )
+        })?;
     }
-    Ok(s.integrals.clone().expect("just set"))
+    s.integrals = Some((grid.clone(), albedo));
+    Ok((grid, albedo))
 }
 
-/// The integral over each cell of the program's `phase` ("pdf" or "eval", channel maximum),
-/// times `measure` (the density's measure per du dv).
-fn integrate<D>(
+/// A domain's grid of cells in parameter space.
+struct Cells {
+    cols: usize,
+    rows: usize,
+    u0: f64,
+    v0: f64,
+    du: f64,
+    dv: f64,
+    /// Errors far below one sample in a million-sample run are irrelevant.
+    tol: f64,
+}
+
+impl Cells {
+    fn of<D: Domain>(domain: &D) -> Cells {
+        let (cols, rows) = domain.resolution();
+        let ([u0, u1], [v0, v1]) = domain.bounds();
+        Cells {
+            cols,
+            rows,
+            u0,
+            v0,
+            du: (u1 - u0) / cols as f64,
+            dv: (v1 - v0) / rows as f64,
+            tol: 1e-9 / (cols * rows) as f64,
+        }
+    }
+
+    fn rect(&self, c: usize, r: usize) -> ([f64; 2], [f64; 2]) {
+        let (i, j) = (c as f64, r as f64);
+        (
+            [self.u0 + i * self.du, self.u0 + (i + 1.0) * self.du],
+            [self.v0 + j * self.dv, self.v0 + (j + 1.0) * self.dv],
+        )
+    }
+
+    /// Every cell's integral of `f`: adaptive with the boundary pass, or by a fixed trapezoid
+    /// of `fixed` x `fixed` intervals (Mitsuba's `ires`).
+    fn integrate(
+        &self,
+        f: &mut dyn FnMut(&[[f64; 2]]) -> Vec<f64>,
+        cfg: &Integration,
+        fixed: Option<usize>,
+    ) -> Grid {
+        let rects: Vec<_> = (0..self.rows * self.cols)
+            .map(|k| self.rect(k % self.cols, k / self.cols))
+            .collect();
+        let data = match fixed {
+            Some(n) => integrate_rects_trapezoid(&rects, f, n),
+            None => integrate_rects_batched(&rects, f, cfg, self.tol),
+        };
+        let mut grid = Grid {
+            cols: self.cols,
+            rows: self.rows,
+            data,
+        };
+        if fixed.is_none() {
+            let rect = |c, r| self.rect(c, r);
+            boundary_pass_batched(&mut grid, &rect, f, cfg, self.tol);
+        }
+        grid
+    }
+}
+
+/// Runs `body` with the program's `phase` (times `measure` and the Jacobian, 0 outside the
+/// domain) as a function of batches of parameter points; the first failed request ends the
+/// queries and is the result.
+fn nodes<D, R>(
     s: &mut Session,
-    cfg: &CaseConfig,
     domain: &D,
     measure: &impl Fn(D::Point) -> f64,
     phase: &str,
     cols: &[usize],
-) -> Result<Grid, String>
+    body: impl FnOnce(&mut dyn FnMut(&[[f64; 2]]) -> Vec<f64>) -> R,
+) -> Result<R, String>
 where
     D: Domain,
     D::Point: Coords,
 {
-    let (ncol, nrow) = domain.resolution();
-    let ([u0, u1], [v0, v1]) = domain.bounds();
-    let (du, dv) = ((u1 - u0) / ncol as f64, (v1 - v0) / nrow as f64);
-    let rects: Vec<([f64; 2], [f64; 2])> = (0..nrow * ncol)
-        .map(|c| {
-            let (i, j) = ((c % ncol) as f64, (c / ncol) as f64);
-            (
-                [u0 + i * du, u0 + (i + 1.0) * du],
-                [v0 + j * dv, v0 + (j + 1.0) * dv],
-            )
-        })
-        .collect();
     let mut failure = None;
     let mut level = 0;
     let jac = domain.jacobian();
-    let data = integrate_rects_batched(
-        &rects,
-        &mut |uv: &[[f64; 2]]| {
-            let pts: Vec<Option<D::Point>> = uv.iter().map(|p| domain.point(p[0], p[1])).collect();
-            let send: Vec<D::Point> = pts.iter().flatten().copied().collect();
-            let what = format!("{phase} phase, integration level {level}");
-            level += 1;
-            let got = match failure {
-                Some(_) => Ok(vec![0.0; send.len()]),
-                None => query(s, phase, &send, cols, &what),
-            };
-            let got = got.unwrap_or_else(|e| {
-                failure = Some(e);
-                vec![0.0; send.len()]
-            });
-            let mut it = got.into_iter();
-            pts.iter()
-                .map(|p| p.map_or(0.0, |p| it.next().unwrap_or(0.0) * jac * measure(p)))
-                .collect()
-        },
-        &cfg.integration,
-        1e-9 / (nrow * ncol) as f64,
-    );
+    let out = body(&mut |uv: &[[f64; 2]]| {
+        let pts: Vec<Option<D::Point>> = uv.iter().map(|p| domain.point(p[0], p[1])).collect();
+        let send: Vec<D::Point> = pts.iter().flatten().copied().collect();
+        let what = format!("{phase} phase, integration batch {level}");
+        level += 1;
+        let got = match failure {
+            Some(_) => Ok(vec![0.0; send.len()]),
+            None => query(s, phase, &send, cols, &what),
+        };
+        let got = got.unwrap_or_else(|e| {
+            failure = Some(e);
+            vec![0.0; send.len()]
+        });
+        let mut it = got.into_iter();
+        pts.iter()
+            .map(|p| p.map_or(0.0, |p| it.next().unwrap_or(0.0) * jac * measure(p)))
+            .collect()
+    });
     match failure {
         Some(e) => Err(e),
-        None => Ok(Grid {
-            cols: ncol,
-            rows: nrow,
-            data,
-        }),
+        None => Ok(out),
     }
 }
 

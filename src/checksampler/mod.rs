@@ -102,6 +102,11 @@ pub struct CheckSamplerArgs {
     /// starts the program anew.)
     #[arg(long, value_parser = crate::limits::parser("--batch", 1, BATCH))]
     pub batch: Option<u64>,
+    /// Integrate each cell's pdf by a fixed N x N trapezoid instead of adaptively, as Mitsuba's
+    /// ChiSquareTest does (its `ires`, 4 by default there): to see what a fixed rule does to
+    /// a sampler whose density has sharp edges. No boundary pass, no recheck.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=64))]
+    pub ires: Option<u64>,
     /// How requests reach the program: `pipe` (one process, requests on its stdin) or
     /// `files` (the program is run once per request with the path of a JSON request file
     /// whose "input" and "output" are .npy files; for batch jobs and graders).
@@ -224,6 +229,7 @@ pub fn run(a: &CheckSamplerArgs) -> Result<Report, String> {
                 Transport::Files => BATCH.max,
             }) as usize,
             integrals: None,
+            ires: a.ires.map(|n| n as usize),
         };
         let mut p_values = Vec::new();
         for s in 0..a.seeds {

@@ -87,6 +87,7 @@ fn run(program: &mut InProcess, target: &Target, seed: u64) -> Outcome {
         dims: 2,
         batch: 8192,
         integrals: None,
+        ires: None,
     };
     check(&mut s, &target.config(&cfg), "in-process").unwrap()
 }
@@ -135,6 +136,7 @@ fn the_integration_is_done_once_per_target_not_once_per_seed() {
         dims: 2,
         batch: 1 << 20,
         integrals: None,
+        ires: None,
     };
     check(&mut s, &cfg, "first").unwrap();
     let after_first = requests.get();

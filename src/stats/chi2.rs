@@ -74,6 +74,34 @@ impl Grid {
     pub fn sum(&self) -> f64 {
         self.data.iter().sum()
     }
+
+    /// The cell and its (up to 8) neighbours.
+    pub fn neighbours(&self, c: usize, r: usize) -> impl Iterator<Item = (usize, usize)> {
+        let (cols, rows) = (self.cols, self.rows);
+        (r.saturating_sub(1)..=(r + 1).min(rows - 1)).flat_map(move |rr| {
+            (c.saturating_sub(1)..=(c + 1).min(cols - 1)).map(move |cc| (cc, rr))
+        })
+    }
+
+    /// Cells on the support's boundary: their 3x3 neighbourhood holds both empty and
+    /// non-empty cells.
+    pub fn boundary_cells(&self) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
+        for r in 0..self.rows {
+            for c in 0..self.cols {
+                let (mut empty, mut full) = (false, false);
+                for (cc, rr) in self.neighbours(c, r) {
+                    let x = self.get(cc, rr);
+                    empty |= x == 0.0;
+                    full |= x > 0.0;
+                }
+                if empty && full {
+                    out.push((c, r));
+                }
+            }
+        }
+        out
+    }
 }
 
 /// Everything a report or heat map needs about one run.
@@ -159,34 +187,8 @@ pub fn cell_integrals_seen<D: Domain>(
     // can pass between all nodes of the first pass, leaving its cells empty or underweighted.
     // An empty cell found non-empty puts its neighbours on the list, following the tip.
     if cfg.boundary_split > cfg.initial_split.max(1) {
-        let levels = (cfg.boundary_split as f64 / cfg.initial_split.max(1) as f64)
-            .log2()
-            .floor() as u32;
-        let fine = Integration {
-            initial_split: cfg.boundary_split,
-            max_depth: cfg.max_depth.saturating_sub(levels),
-            ..*cfg
-        };
-        let neighbours = |c: usize, r: usize| {
-            let rs = r.saturating_sub(1)..=(r + 1).min(rows - 1);
-            rs.flat_map(move |rr| {
-                (c.saturating_sub(1)..=(c + 1).min(cols - 1)).map(move |cc| (cc, rr))
-            })
-        };
-        let mut todo: Vec<(usize, usize)> = Vec::new();
-        for r in 0..rows {
-            for c in 0..cols {
-                let (mut empty, mut full) = (false, false);
-                for (cc, rr) in neighbours(c, r) {
-                    let x = grid.get(cc, rr);
-                    empty |= x == 0.0;
-                    full |= x > 0.0;
-                }
-                if empty && full {
-                    todo.push((c, r));
-                }
-            }
-        }
+        let fine = cfg.finer(cfg.boundary_split);
+        let mut todo = grid.boundary_cells();
         let mut done = vec![false; cols * rows];
         while let Some((c, r)) = todo.pop() {
             if std::mem::replace(&mut done[r * cols + c], true) {
@@ -198,19 +200,15 @@ pub fn cell_integrals_seen<D: Domain>(
             let now = integrate_rect(&mut f, u, v, &fine, abs_tol);
             grid.data[r * cols + c] = now;
             if was == 0.0 && now > 0.0 {
-                todo.extend(neighbours(c, r).filter(|&(cc, rr)| !done[rr * cols + cc]));
+                todo.extend(
+                    grid.neighbours(c, r)
+                        .filter(|&(cc, rr)| !done[rr * cols + cc]),
+                );
             }
         }
     }
     if let Some(seen) = observed.filter(|_| cfg.recheck_split > 1) {
-        let levels = (cfg.recheck_split as f64 / cfg.initial_split.max(1) as f64)
-            .log2()
-            .floor() as u32;
-        let fine = Integration {
-            initial_split: cfg.recheck_split,
-            max_depth: cfg.max_depth.saturating_sub(levels),
-            ..*cfg
-        };
+        let fine = cfg.finer(cfg.recheck_split);
         for r in 0..rows {
             for c in 0..cols {
                 if grid.get(c, r) == 0.0 && seen.get(c, r) > 0.0 {

@@ -43,6 +43,21 @@ impl Default for Integration {
     }
 }
 
+impl Integration {
+    /// A second look starting from `split x split` rectangles that refines to the same finest
+    /// scale as the first.
+    pub fn finer(&self, split: usize) -> Integration {
+        let levels = (split as f64 / self.initial_split.max(1) as f64)
+            .log2()
+            .floor() as u32;
+        Integration {
+            initial_split: split,
+            max_depth: self.max_depth.saturating_sub(levels),
+            ..*self
+        }
+    }
+}
+
 /// Simpson weights of a 3x3 grid, times 36.
 const W3: [f64; 3] = [1.0, 4.0, 1.0];
 

@@ -9,6 +9,7 @@
 //! order of summation.
 
 use super::integrate::{looks_discontinuous, quadrants, simpson3, trapezoid5, Integration};
+use super::Grid;
 
 /// A rectangle waiting for its 16 refinement nodes.
 struct Pending {
@@ -122,6 +123,103 @@ pub fn integrate_rects_batched(
     totals
 }
 
+/// The first second look of [`crate::stats::chi2::cell_integrals_seen`], batched: cells on
+/// the support's boundary again from `cfg.boundary_split` rectangles, in rounds, each round
+/// also taking the neighbours of cells found non-empty, so a sliver's tip is followed.
+/// `rect(c, r)` is cell (c, r)'s parameter rectangle.
+pub fn boundary_pass_batched(
+    grid: &mut Grid,
+    rect: &impl Fn(usize, usize) -> ([f64; 2], [f64; 2]),
+    f: &mut dyn FnMut(&[[f64; 2]]) -> Vec<f64>,
+    cfg: &Integration,
+    abs_tol: f64,
+) {
+    if cfg.boundary_split <= cfg.initial_split.max(1) {
+        return;
+    }
+    let cols = grid.cols;
+    let fine = cfg.finer(cfg.boundary_split);
+    let mut done = vec![false; grid.data.len()];
+    let mut todo = grid.boundary_cells();
+    while !todo.is_empty() {
+        let cells: Vec<(usize, usize)> = todo
+            .drain(..)
+            .filter(|&(c, r)| !std::mem::replace(&mut done[r * cols + c], true))
+            .collect();
+        let rects: Vec<_> = cells.iter().map(|&(c, r)| rect(c, r)).collect();
+        let now = integrate_rects_batched(&rects, f, &fine, abs_tol);
+        for (&(c, r), x) in cells.iter().zip(now) {
+            let was = std::mem::replace(&mut grid.data[r * cols + c], x);
+            if was == 0.0 && x > 0.0 {
+                todo.extend(
+                    grid.neighbours(c, r)
+                        .filter(|&(cc, rr)| !done[rr * cols + cc]),
+                );
+            }
+        }
+    }
+}
+
+/// The second one: cells that received samples (`seen`) but integrate to 0, again from
+/// `cfg.recheck_split` rectangles, in one batch.
+pub fn recheck_batched(
+    grid: &mut Grid,
+    rect: &impl Fn(usize, usize) -> ([f64; 2], [f64; 2]),
+    f: &mut dyn FnMut(&[[f64; 2]]) -> Vec<f64>,
+    cfg: &Integration,
+    abs_tol: f64,
+    seen: &Grid,
+) {
+    if cfg.recheck_split <= 1 {
+        return;
+    }
+    let cols = grid.cols;
+    let cells: Vec<(usize, usize)> = (0..grid.rows)
+        .flat_map(|r| (0..cols).map(move |c| (c, r)))
+        .filter(|&(c, r)| grid.get(c, r) == 0.0 && seen.get(c, r) > 0.0)
+        .collect();
+    let rects: Vec<_> = cells.iter().map(|&(c, r)| rect(c, r)).collect();
+    let now = integrate_rects_batched(&rects, f, &cfg.finer(cfg.recheck_split), abs_tol);
+    for (&(c, r), x) in cells.iter().zip(now) {
+        grid.data[r * cols + c] = x;
+    }
+}
+
+/// The integral of `f` over each rectangle by a fixed `(n + 1) x (n + 1)`-node trapezoid
+/// rule, in one batch: what Mitsuba's `ChiSquareTest` does with `ires = n`, kept to show
+/// what adaptive integration changes (`check-sampler --ires`).
+pub fn integrate_rects_trapezoid(
+    rects: &[([f64; 2], [f64; 2])],
+    f: &mut dyn FnMut(&[[f64; 2]]) -> Vec<f64>,
+    n: usize,
+) -> Vec<f64> {
+    let n = n.max(1);
+    let mut points = Vec::with_capacity(rects.len() * (n + 1) * (n + 1));
+    for (u, v) in rects {
+        for j in 0..=n {
+            for i in 0..=n {
+                let (a, b) = (i as f64 / n as f64, j as f64 / n as f64);
+                points.push([u[0] + a * (u[1] - u[0]), v[0] + b * (v[1] - v[0])]);
+            }
+        }
+    }
+    let values = evaluate(f, &points);
+    let w = |i: usize| if i == 0 || i == n { 0.5 } else { 1.0 };
+    rects
+        .iter()
+        .zip(values.chunks_exact((n + 1) * (n + 1)))
+        .map(|((u, v), vals)| {
+            let area = (u[1] - u[0]) * (v[1] - v[0]);
+            let sum: f64 = vals
+                .iter()
+                .enumerate()
+                .map(|(k, x)| w(k % (n + 1)) * w(k / (n + 1)) * x)
+                .sum();
+            sum * area / (n * n) as f64
+        })
+        .collect()
+}
+
 fn evaluate(f: &mut dyn FnMut(&[[f64; 2]]) -> Vec<f64>, points: &[[f64; 2]]) -> Vec<f64> {
     if points.is_empty() {
         return Vec::new();
@@ -228,5 +326,93 @@ mod tests {
                 "{name}: {batches} batches"
             );
         }
+    }
+
+    /// A thin wedge whose tip passes between the first pass's nodes, and samples seen where
+    /// the wedge is thinnest: the batched second looks give the recursive ones' masses.
+    #[test]
+    fn boundary_pass_and_recheck_equal_the_recursive_ones() {
+        use crate::stats::chi2::cell_integrals_seen;
+        use crate::stats::UnitSquare;
+        use glam::Vec2;
+        // Between v = 0.3 and v = 0.3 + 0.08 u^3: wide enough at u = 1 for the first pass,
+        // a tip thinner than its node spacing towards u = 0.
+        let wedge = |u: f64, v: f64| {
+            let (lo, hi) = (0.3, 0.3 + 0.08 * u * u * u);
+            if v >= lo && v <= hi {
+                1.0
+            } else {
+                0.0
+            }
+        };
+        let d = UnitSquare { n: 9 };
+        let cfg = Integration {
+            boundary_split: 8,
+            ..Integration::default()
+        };
+        let mut seen = Grid::new(9, 9);
+        seen.data[2 * 9] = 3.0;
+        let pdf = |p: Vec2| wedge(p.x as f64, p.y as f64);
+        let (want, _) = cell_integrals_seen(&d, pdf, &cfg, Some(&seen));
+        let rects = cells(9);
+        // The domain hands the pdf f32 points: round the nodes alike.
+        let r32 = |x: f64| x as f32 as f64;
+        let mut f = |pts: &[[f64; 2]]| pts.iter().map(|p| wedge(r32(p[0]), r32(p[1]))).collect();
+        let abs_tol = 1e-9 / 81.0;
+        let mut got = Grid {
+            cols: 9,
+            rows: 9,
+            data: integrate_rects_batched(&rects, &mut f, &cfg, abs_tol),
+        };
+        let first = got.data.clone();
+        let rect = |c: usize, r: usize| rects[r * 9 + c];
+        boundary_pass_batched(&mut got, &rect, &mut f, &cfg, abs_tol);
+        assert_ne!(
+            first, got.data,
+            "the first pass alone already had the wedge"
+        );
+        recheck_batched(&mut got, &rect, &mut f, &cfg, abs_tol, &seen);
+        for (k, (a, b)) in got.data.iter().zip(&want.data).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-12 * b.abs().max(1e-300),
+                "cell {k}: {a} vs {b}"
+            );
+        }
+        assert!(want.sum() > 0.0);
+    }
+
+    /// The fixed trapezoid is exact for bilinear integrands and has the error an edge gives
+    /// it: on a disk's rim it is off by far more than the adaptive rule.
+    #[test]
+    fn fixed_trapezoid_is_exact_for_bilinear_and_coarse_on_edges() {
+        let rects = cells(3);
+        let mut bilinear = |p: &[[f64; 2]]| p.iter().map(|q| 1.0 + q[0] * q[1]).collect();
+        let got = integrate_rects_trapezoid(&rects, &mut bilinear, 4);
+        for ((u, v), x) in rects.iter().zip(&got) {
+            let exact = (u[1] - u[0]) * (v[1] - v[0])
+                + (u[1] * u[1] - u[0] * u[0]) * (v[1] * v[1] - v[0] * v[0]) / 4.0;
+            assert!((x - exact).abs() < 1e-14, "{x} vs {exact}");
+        }
+        let rim = |p: &[[f64; 2]]| {
+            p.iter()
+                .map(|q| ((q[0] - 0.5).powi(2) + (q[1] - 0.5).powi(2) <= 0.1) as u8 as f64)
+                .collect::<Vec<_>>()
+        };
+        let area = std::f64::consts::PI * 0.1;
+        let fixed: f64 = integrate_rects_trapezoid(&cells(7), &mut |p| rim(p), 4)
+            .iter()
+            .sum();
+        let cfg = Integration::default();
+        let adaptive: f64 = integrate_rects_batched(&cells(7), &mut |p| rim(p), &cfg, 1e-12)
+            .iter()
+            .sum();
+        assert!(
+            (adaptive - area).abs() < 1e-4,
+            "adaptive {adaptive} vs {area}"
+        );
+        assert!(
+            (fixed - area).abs() > 10.0 * (adaptive - area).abs(),
+            "fixed {fixed}"
+        );
     }
 }

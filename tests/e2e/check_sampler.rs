@@ -299,3 +299,23 @@ fn the_files_transport_gives_the_pipes_result_and_names_bad_replies() {
         assert!(text.contains("sample phase, batch 0"), "{text}");
     }
 }
+
+/// The point against a fixed per-cell rule: at 1e6 samples a correct rectangle-light
+/// sampler passes with adaptive integration and is rejected (p ~ 0) when every cell is
+/// integrated by a fixed 4 x 4 trapezoid, as Mitsuba's ChiSquareTest does.
+#[test]
+fn a_rectangle_light_passes_where_a_fixed_trapezoid_rejects_it() {
+    if !numpy() {
+        return;
+    }
+    let example = repo("examples/samplers/rectangle_light.py");
+    let prog = ["python3", example.to_str().unwrap()];
+    let (ok, text) = check_with(&["--domain", "sphere"], &prog);
+    assert!(ok, "{text}");
+    let (ok, text) = check_with(&["--domain", "sphere", "--ires", "4"], &prog);
+    assert!(
+        !ok && text.contains("the histogram's shape failed"),
+        "{text}"
+    );
+    assert!(number_after(&text, "p = ") < 1e-10, "{text}");
+}
