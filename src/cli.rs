@@ -46,8 +46,9 @@ pub enum Command {
     /// with heat maps; exits non-zero if any case fails.
     Chi2(crate::chi2cases::command::Chi2Args),
     /// Check a sampler written in any language: its program, run after `--`, answers sample
-    /// and pdf requests on stdin/stdout (helpers/python/directlab_sampler.py); exits non-zero
-    /// if it fails.
+    /// and pdf requests (helpers/python/directlab_sampler.py, helpers/cpp/directlab_sampler.hpp);
+    /// exits non-zero if it fails.
+    #[command(after_long_help = crate::checksampler::HELP)]
     CheckSampler(crate::checksampler::CheckSamplerArgs),
     /// Run Nori test files (`<test type="ttest">`, `<test type="chi2test">`): scenes against
     /// references per strategy, BSDF albedos, BSDF chi-square; exits non-zero on a failure.

@@ -2,8 +2,10 @@
 uniform numbers as directlab's Rust code does, so it gets the built-in case's p-value.
 
     directlab check-sampler --case warp/uniform-disk -- python3 directlab_warps.py uniform-disk
-    directlab check-sampler --case warp/cosine-hemisphere -- python3 directlab_warps.py cosine-hemisphere
-    directlab check-sampler --case warp/spherical-triangle -- python3 directlab_warps.py spherical-triangle
+    directlab check-sampler --case warp/cosine-hemisphere -- \
+        python3 directlab_warps.py cosine-hemisphere
+    directlab check-sampler --case warp/spherical-triangle -- \
+        python3 directlab_warps.py spherical-triangle
     directlab check-sampler --case warp/beckmann-a0.5-dcos -- python3 directlab_warps.py beckmann
 
 The spherical triangle's vertices and Beckmann's roughness come with each request."""
@@ -63,7 +65,8 @@ def spherical_triangle(u, params):
     phi = np.pi + u[0] * area - alpha
     s, t = np.sin(phi), np.cos(phi)
     k1, k2 = t + np.cos(alpha), s - np.sin(alpha) * (a @ b)
-    cos_bp = np.clip((k2 + (k2 * t - k1 * s) * np.cos(alpha)) / ((k2 * s + k1 * t) * np.sin(alpha)), -1, 1)
+    num = k2 + (k2 * t - k1 * s) * np.cos(alpha)
+    cos_bp = np.clip(num / ((k2 * s + k1 * t) * np.sin(alpha)), -1, 1)
     c_perp = c - a * (c @ a)
     c_perp /= np.linalg.norm(c_perp)
     cp = a[:, None] * cos_bp + c_perp[:, None] * np.sqrt(np.maximum(0, 1 - cos_bp**2))

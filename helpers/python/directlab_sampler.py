@@ -18,8 +18,9 @@ statistics:
     directlab check-sampler --domain hemisphere -- python3 my_sampler.py
 
 Two transports carry the same messages. Pipe (the default): each request is a JSON header
-line {"phase", "domain", "count", "dim", "point_dim", "params"} followed by count x dim little-endian f64
-(row-major); each reply a JSON header line {"count", "cols"} followed by count x cols f64.
+line {"phase", "domain", "count", "dim", "point_dim", "params"} followed by count x dim
+little-endian f64 (row-major); each reply a JSON header line {"count", "cols"} followed by
+count x cols f64.
 Files (`--transport files`): the program is run once per request with the path of a JSON file
 holding the same header plus "input" and "output", the paths of .npy files (count x dim in,
 count x cols out). A "sample" reply has columns point..., pdf, valid (1 or 0), weight...; a

@@ -24,6 +24,36 @@ use serde_json::{Map, Value};
 use std::path::PathBuf;
 use std::time::Duration;
 
+/// `check-sampler --help`'s closing text: a start and the protocol.
+pub const HELP: &str = "\
+Quick start (Python with numpy; C++: helpers/cpp/directlab_sampler.hpp):
+  # my_sampler.py
+  import numpy as np
+  from directlab_sampler import serve        # PYTHONPATH=helpers/python
+  def sample(u):                             # (2, N) uniforms -> (3, N) directions
+      r, phi = np.sqrt(u[0]), 2 * np.pi * u[1]
+      return np.array([r * np.cos(phi), r * np.sin(phi), np.sqrt(1 - u[0])])
+  def pdf(d):                                # (3, N) -> density per steradian
+      return np.maximum(d[2], 0) / np.pi
+  serve(sample, pdf)
+
+  directlab check-sampler --domain hemisphere -- python3 my_sampler.py
+  directlab check-sampler --case warp/cosine-hemisphere -- python3 my_sampler.py
+  helpers/nori/check-warps path/to/nori/src/warp.cpp
+
+Protocol (pipe): each request is a JSON header line
+  {\"phase\", \"domain\", \"count\", \"dim\", \"point_dim\", \"params\"}
+then count x dim little-endian f64; each reply is a JSON line {\"count\", \"cols\"} then
+count x cols f64. Phases: \"sample\" (dim uniforms per row; reply: point (point_dim values),
+pdf, valid 1/0, optional weight (1 or 3)), \"pdf\" and \"eval\" (points; reply: one value, or
+3 for eval), then {\"phase\": \"end\"}. With --transport files the program is run once per
+request with the path of a JSON file (the same header plus \"input\" and \"output\", .npy
+files of count x dim and count x cols f64).
+
+Every run draws its numbers from --seed; the same seed gives the same result. A program that
+exits, hangs past --timeout, answers the wrong shape or a non-finite value ends the run with
+an error naming the phase and batch.";
+
 const RESOLUTION: Bound = Bound {
     max: 1024,
     why: "a 1024-row grid already has a million cells (two million on the sphere)",

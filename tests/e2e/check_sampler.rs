@@ -319,3 +319,42 @@ fn a_rectangle_light_passes_where_a_fixed_trapezoid_rejects_it() {
     );
     assert!(number_after(&text, "p = ") < 1e-10, "{text}");
 }
+
+/// The README's walkthrough as written: its Python file, then each of its `directlab
+/// check-sampler` lines (at full size, output redirected to scratch) passes.
+#[test]
+fn the_readme_walkthrough_works_as_written() {
+    if !numpy() {
+        return;
+    }
+    let readme = std::fs::read_to_string(repo("README.md")).unwrap();
+    let section = &readme[readme.find("## Checking your own sampler").unwrap()..];
+    let block = |fence: &str| {
+        let at = section.find(fence).unwrap() + fence.len();
+        section[at..at + section[at..].find("```").unwrap()].to_string()
+    };
+    let dir = scratch("readme-walkthrough");
+    std::fs::write(dir.join("my_sampler.py"), block("```python\n")).unwrap();
+    let lines: Vec<String> = block("```sh\n")
+        .lines()
+        .filter(|l| l.starts_with("directlab check-sampler"))
+        .map(|l| l.split('#').next().unwrap().to_string())
+        .collect();
+    assert_eq!(lines.len(), 2, "{lines:?}");
+    for line in lines {
+        let words: Vec<&str> = line.split_whitespace().skip(1).collect();
+        let split = words.iter().position(|w| *w == "--").unwrap();
+        let o = run(directlab()
+            .args(&words[..split])
+            .arg("--out")
+            .arg(dir.join("out"))
+            .args(&words[split..])
+            .current_dir(&dir)
+            .env("PYTHONPATH", repo("helpers/python")));
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            o.status.success() && text.contains(": pass ("),
+            "{line}: {text}"
+        );
+    }
+}

@@ -99,7 +99,8 @@ static bool spherical_triangle(const double *u, const Params &p, double *x) {
     double area = alpha + corner(b, c, a) + corner(c, a, b) - PI;
     double phi = PI + u[0] * area - alpha, s = std::sin(phi), t = std::cos(phi);
     double k1 = t + std::cos(alpha), k2 = s - std::sin(alpha) * dot(a, b);
-    double cos_bp = (k2 + (k2 * t - k1 * s) * std::cos(alpha)) / ((k2 * s + k1 * t) * std::sin(alpha));
+    double num = k2 + (k2 * t - k1 * s) * std::cos(alpha);
+    double cos_bp = num / ((k2 * s + k1 * t) * std::sin(alpha));
     cos_bp = std::fmax(-1.0, std::fmin(1.0, cos_bp));
     V3 c_perp = unit(add(c, a, -dot(c, a)));
     V3 cp = add(scale(a, cos_bp), c_perp, std::sqrt(std::fmax(0.0, 1 - cos_bp * cos_bp)));
@@ -120,7 +121,8 @@ static double spherical_triangle_pdf(const double *d, const Params &p) {
     for (int i = 0; i < 3; ++i)
         if (dot(cross(add(v[(i + 1) % 3], v[i], -1), add(hit, v[i], -1)), n) < 0) return 0;
     V3 a = unit(v[0]), b = unit(v[1]), c = unit(v[2]);
-    double omega = 2 * std::atan2(std::fabs(dot(a, cross(b, c))), 1 + dot(a, b) + dot(b, c) + dot(c, a));
+    double den = 1 + dot(a, b) + dot(b, c) + dot(c, a);
+    double omega = 2 * std::atan2(std::fabs(dot(a, cross(b, c))), den);
     return 1 / omega;
 }
 
@@ -147,8 +149,10 @@ int main(int argc, char **argv) {
     directlab::Sampler s;
     if (warp == "uniform-disk") s.sample = uniform_disk, s.pdf = disk_pdf;
     else if (warp == "concentric-disk") s.sample = concentric_disk, s.pdf = disk_pdf;
-    else if (warp == "cosine-hemisphere") s.sample = cosine_hemisphere, s.pdf = cosine_hemisphere_pdf;
-    else if (warp == "spherical-triangle") s.sample = spherical_triangle, s.pdf = spherical_triangle_pdf;
+    else if (warp == "cosine-hemisphere")
+        s.sample = cosine_hemisphere, s.pdf = cosine_hemisphere_pdf;
+    else if (warp == "spherical-triangle")
+        s.sample = spherical_triangle, s.pdf = spherical_triangle_pdf;
     else if (warp == "beckmann") s.sample = beckmann, s.pdf = beckmann_pdf;
     else {
         std::fprintf(stderr, "usage: %s uniform-disk|concentric-disk|cosine-hemisphere|"

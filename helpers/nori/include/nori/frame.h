@@ -32,8 +32,12 @@ struct Frame {
         float s = sinTheta(v);
         return s == 0.0f ? 1.0f : clamp(v.x() / s, -1.0f, 1.0f);
     }
-    static float sinPhi2(const Vector3f &v) { return clamp(v.y() * v.y() / sinTheta2(v), 0.0f, 1.0f); }
-    static float cosPhi2(const Vector3f &v) { return clamp(v.x() * v.x() / sinTheta2(v), 0.0f, 1.0f); }
+    static float sinPhi2(const Vector3f &v) {
+        return clamp(v.y() * v.y() / sinTheta2(v), 0.0f, 1.0f);
+    }
+    static float cosPhi2(const Vector3f &v) {
+        return clamp(v.x() * v.x() / sinTheta2(v), 0.0f, 1.0f);
+    }
 };
 
 NORI_NAMESPACE_END
