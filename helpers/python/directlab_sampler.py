@@ -113,3 +113,92 @@ def serve(sample_func, pdf_func, eval_func=None, stdin=None, stdout=None):
         raw = inp.read(8 * n * dim)
         data = np.frombuffer(raw, dtype="<f8").reshape(n, dim)
         _reply(out, answer(head, data, sample_func, pdf_func, eval_func))
+
+
+# Mitsuba 3's test, run by directlab: a test written for mitsuba.chi2 ports by changing its
+# import (with numpy arrays in place of Dr.Jit's).
+
+
+class PlanarDomain:
+    """Points of the rectangle `bounds` = [[x0, x1], [y0, y1]] ([-1, 1]^2 by default, as in
+    Mitsuba), density per unit area."""
+
+    def __init__(self, bounds=None):
+        self.bounds = np.array([[-1.0, 1.0], [-1.0, 1.0]] if bounds is None else bounds, float)
+
+
+class SphericalDomain:
+    """Unit directions, density per steradian."""
+
+
+def _directlab():
+    if os.environ.get("DIRECTLAB"):
+        return os.environ["DIRECTLAB"]
+    built = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "target",
+                         "release", "directlab")
+    return built if os.path.exists(built) else "directlab"
+
+
+class ChiSquareTest:
+    """Mitsuba's ChiSquareTest(domain, sample_func, pdf_func, sample_dim, sample_count, res,
+    ires, seed): `run()` starts `directlab check-sampler --transport stdio` and answers its
+    requests from this process. directlab integrates adaptively (`ires` is not used), on a
+    grid of about the same number of cells; its report goes to stderr, and to `messages`."""
+
+    def __init__(self, domain, sample_func, pdf_func, sample_dim=2, sample_count=1000000,
+                 res=101, ires=4, seed=0):
+        self.domain, self.sample_func, self.pdf_func = domain, sample_func, pdf_func
+        self.sample_dim, self.sample_count, self.res, self.seed = (
+            sample_dim, int(sample_count), int(res), int(seed))
+        self.messages = ""
+
+    def _planar(self):
+        (x0, x1), (y0, y1) = self.domain.bounds
+        lo, size = np.array([[x0], [y0]]), np.array([[x1 - x0], [y1 - y0]])
+
+        def sample(u):
+            res = self.sample_func(u)
+            pts, w = res if isinstance(res, tuple) else (res, None)
+            pts = (np.asarray(pts, dtype=np.float64) - lo) / size
+            return pts if w is None else (pts, w)
+
+        def pdf(x):
+            return np.asarray(self.pdf_func(lo + x * size), dtype=np.float64) * size.prod()
+
+        return sample, pdf
+
+    def run(self, significance_level=0.01, test_count=1, quiet=False, out=None):
+        """True when the sampler passes at `significance_level` (Sidak-split over
+        `test_count` tests, as Mitsuba does); heat maps go to `out` (directlab's default
+        reports/check-sampler)."""
+        import subprocess
+        import threading
+
+        alpha = 1 - (1 - significance_level) ** (1 / test_count)
+        if isinstance(self.domain, SphericalDomain):
+            domain, res, (sample, pdf) = "sphere", (self.res + 1) // 2, (
+                self.sample_func, self.pdf_func)
+        else:
+            domain, res, (sample, pdf) = "square", self.res, self._planar()
+        args = [_directlab(), "check-sampler", "--transport", "stdio", "--domain", domain,
+                "--samples", str(self.sample_count), "--dims", str(self.sample_dim),
+                "--resolution", str(res), "--seed", str(self.seed), "--alpha", repr(alpha)]
+        if out is not None:
+            args += ["--out", str(out)]
+        proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE)
+        report = []
+        reader = threading.Thread(target=lambda: report.append(proc.stderr.read()))
+        reader.start()
+        try:
+            serve(sample, pdf, stdin=proc.stdout, stdout=proc.stdin)
+        except BrokenPipeError:
+            pass
+        finally:
+            proc.stdin.close()
+        proc.wait()
+        reader.join()
+        self.messages = report[0].decode(errors="replace")
+        if not quiet:
+            sys.stderr.write(self.messages)
+        return proc.returncode == 0

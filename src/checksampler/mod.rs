@@ -95,6 +95,7 @@ pub enum DomainKind {
 pub enum Transport {
     Pipe,
     Files,
+    Stdio,
 }
 
 #[derive(clap::Args, Debug)]
@@ -137,9 +138,11 @@ pub struct CheckSamplerArgs {
     /// a sampler whose density has sharp edges. No boundary pass, no recheck.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=64))]
     pub ires: Option<u64>,
-    /// How requests reach the program: `pipe` (one process, requests on its stdin) or
-    /// `files` (the program is run once per request with the path of a JSON request file
-    /// whose "input" and "output" are .npy files; for batch jobs and graders).
+    /// How requests reach the program: `pipe` (one process, requests on its stdin), `files`
+    /// (the program is run once per request with the path of a JSON request file whose
+    /// "input" and "output" are .npy files; for batch jobs and graders), or `stdio` (the
+    /// program is the one that started directlab: requests on directlab's stdout, replies
+    /// on its stdin, the report on stderr; the Python helper's ChiSquareTest.run()).
     #[arg(long, value_enum, default_value_t = Transport::Pipe)]
     pub transport: Transport,
     /// Seconds to wait for each reply before the program is killed.
@@ -151,8 +154,9 @@ pub struct CheckSamplerArgs {
     /// Where the heat map goes.
     #[arg(long, default_value = "reports/check-sampler")]
     pub out: PathBuf,
-    /// The sampler program and its arguments, after `--` (e.g. `-- python3 my_sampler.py`).
-    #[arg(last = true, required = true)]
+    /// The sampler program and its arguments, after `--` (e.g. `-- python3 my_sampler.py`);
+    /// none with `--transport stdio`.
+    #[arg(last = true)]
     pub command: Vec<String>,
 }
 
@@ -160,20 +164,26 @@ pub struct CheckSamplerArgs {
 pub fn command(a: &CheckSamplerArgs) -> Result<(), String> {
     let r = run(a)?;
     let verdict = |ok: bool| if ok { "pass" } else { "FAIL" };
+    // With --transport stdio, stdout carries the protocol: the report goes to stderr.
+    let mut text = String::new();
     for (o, map) in &r.outcomes {
-        println!(
-            "{}: {} ({}); heat map {}",
+        text += &format!(
+            "{}: {} ({}); heat map {}\n",
             o.name,
             verdict(o.passed()),
             o.summary(),
             map.display()
         );
         for c in &o.checks {
-            println!("  {}: {} ({})", c.name, verdict(c.passed), c.detail);
+            text += &format!("  {}: {} ({})\n", c.name, verdict(c.passed), c.detail);
         }
     }
     for (name, c) in &r.calibration {
-        println!("{name}: {}: {} ({})", c.name, verdict(c.passed), c.detail);
+        text += &format!("{name}: {}: {} ({})\n", c.name, verdict(c.passed), c.detail);
+    }
+    match a.transport {
+        Transport::Stdio => eprint!("{text}"),
+        _ => print!("{text}"),
     }
     let failed = r.outcomes.iter().filter(|(o, _)| !o.passed()).count()
         + r.calibration.iter().filter(|(_, c)| !c.passed).count();
@@ -238,6 +248,14 @@ pub fn run(a: &CheckSamplerArgs) -> Result<Report, String> {
     let mut program: Box<dyn Program> = match a.transport {
         Transport::Pipe => Box::new(Pipe::start(&a.command, timeout)?),
         Transport::Files => Box::new(Files::new(&a.command, a.out.join("requests"), timeout)?),
+        Transport::Stdio if !a.command.is_empty() => {
+            return Err(
+                "--transport stdio talks to the process that started directlab: \
+                        give no program after --"
+                    .into(),
+            )
+        }
+        Transport::Stdio => Box::new(Pipe::stdio(timeout)),
     };
     // The run as a whole is at --alpha: each check at the Sidak level over all of them.
     let runs = jobs.len() * a.seeds as usize;
@@ -255,7 +273,7 @@ pub fn run(a: &CheckSamplerArgs) -> Result<Report, String> {
             params: sent,
             dims: a.dims as usize,
             batch: a.batch.unwrap_or(match a.transport {
-                Transport::Pipe => 65_536,
+                Transport::Pipe | Transport::Stdio => 65_536,
                 Transport::Files => BATCH.max,
             }) as usize,
             integrals: None,

@@ -3,18 +3,23 @@
 //! every reply one JSON header line (`{"count": n, "cols": c}`) on its stdout followed by
 //! `count x cols` f64. A reply that does not come within the timeout, a program that exits,
 //! a wrong count or a non-finite value is an error naming the phase and the batch.
+//!
+//! [`Pipe::stdio`] turns it around for a program that runs directlab itself (the Python
+//! helper's `ChiSquareTest.run()`): requests go out on directlab's stdout, replies come in
+//! on its stdin.
 
 use super::program::{validate, Program};
 use serde_json::{json, Value};
-use std::io::{BufRead, BufReader, Write};
-use std::process::{Child, ChildStdin, Command, Stdio};
+use std::io::{BufRead, BufReader, Read, Write};
+use std::process::{Child, Command, Stdio};
 use std::sync::mpsc::{channel, Receiver, RecvTimeoutError};
 use std::time::Duration;
 
 /// A running sampler program.
 pub struct Pipe {
-    child: Child,
-    stdin: Option<ChildStdin>,
+    /// None when the program is the process that started directlab.
+    child: Option<Child>,
+    stdin: Option<Box<dyn Write + Send>>,
     replies: Receiver<Result<(Value, Vec<f64>), String>>,
     timeout: Duration,
     program: String,
@@ -40,25 +45,42 @@ impl Pipe {
             .spawn()
             .map_err(|e| format!("check-sampler: cannot start '{prog}': {e}"))?;
         let stdout = child.stdout.take().expect("piped");
-        let (tx, replies) = channel();
-        std::thread::spawn(move || {
-            let mut r = BufReader::new(stdout);
-            loop {
-                let msg = read_message(&mut r);
-                let stop = msg.is_err();
-                if tx.send(msg).is_err() || stop {
-                    break;
-                }
-            }
-        });
+        let stdin = child.stdin.take().expect("piped");
         Ok(Pipe {
-            stdin: child.stdin.take(),
-            child,
-            replies,
+            stdin: Some(Box::new(stdin)),
+            child: Some(child),
+            replies: listen(stdout),
             timeout,
             program: command.join(" "),
         })
     }
+
+    /// The program that started directlab, over directlab's own stdin and stdout.
+    pub fn stdio(timeout: Duration) -> Pipe {
+        Pipe {
+            stdin: Some(Box::new(std::io::stdout())),
+            child: None,
+            replies: listen(std::io::stdin()),
+            timeout,
+            program: "the parent process (--transport stdio)".into(),
+        }
+    }
+}
+
+/// Reads replies from `from` on a thread of their own, so a silent program can time out.
+fn listen(from: impl Read + Send + 'static) -> Receiver<Result<(Value, Vec<f64>), String>> {
+    let (tx, replies) = channel();
+    std::thread::spawn(move || {
+        let mut r = BufReader::new(from);
+        loop {
+            let msg = read_message(&mut r);
+            let stop = msg.is_err();
+            if tx.send(msg).is_err() || stop {
+                break;
+            }
+        }
+    });
+    replies
 }
 
 impl Program for Pipe {
@@ -88,7 +110,9 @@ impl Program for Pipe {
         let reply = match self.replies.recv_timeout(self.timeout) {
             Ok(r) => r,
             Err(RecvTimeoutError::Timeout) => {
-                let _ = self.child.kill();
+                if let Some(c) = &mut self.child {
+                    let _ = c.kill();
+                }
                 return Err(fail(format!(
                     "no reply within {} s from '{}' (killed)",
                     self.timeout.as_secs_f64(),
@@ -112,7 +136,10 @@ impl Program for Pipe {
             // The program's exit status, once it has one (its output ends just before).
             let mut status = None;
             for _ in 0..200 {
-                status = self.child.try_wait().ok().flatten();
+                status = self
+                    .child
+                    .as_mut()
+                    .and_then(|c| c.try_wait().ok().flatten());
                 if status.is_some() {
                     break;
                 }
@@ -130,15 +157,19 @@ impl Program for Pipe {
     fn finish(&mut self) {
         if let Some(mut s) = self.stdin.take() {
             let _ = s.write_all(format!("{}\n", json!({"phase": "end"})).as_bytes());
+            let _ = s.flush();
         }
-        let _ = self.child.wait();
+        if let Some(c) = &mut self.child {
+            let _ = c.wait();
+        }
     }
 }
 
 impl Drop for Pipe {
     fn drop(&mut self) {
-        if self.child.try_wait().ok().flatten().is_none() && self.stdin.is_none() {
-            let _ = self.child.kill();
+        let Some(c) = &mut self.child else { return };
+        if c.try_wait().ok().flatten().is_none() && self.stdin.is_none() {
+            let _ = c.kill();
         }
     }
 }

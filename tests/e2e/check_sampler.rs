@@ -8,7 +8,10 @@
 //! - the diffuse BSDF example passes, and its wrong weight, eval and support are each caught
 //!   by the check that should catch them;
 //! - programs that crash, hang, answer the wrong count or a NaN end in an error naming the
-//!   phase and batch.
+//!   phase and batch, through the pipe and through files;
+//! - a correct rectangle light passes where Mitsuba's fixed 4x4 trapezoid (`--ires 4`)
+//!   rejects it (1e6 samples); a Mitsuba-style ChiSquareTest runs unchanged but for its
+//!   import; the README's walkthrough runs as written.
 //!
 //! Without numpy the tests say so and are skipped, unless DIRECTLAB_REQUIRE_NUMPY=1 (set by
 //! `.ci/run` once numpy imports).
@@ -357,4 +360,41 @@ fn the_readme_walkthrough_works_as_written() {
             "{line}: {text}"
         );
     }
+}
+
+/// A test written for Mitsuba's chi2 module with only its import changed: the Python
+/// helper's ChiSquareTest runs directlab (`--transport stdio`) and answers it; a halved pdf
+/// makes run() return False.
+#[test]
+fn a_mitsuba_style_test_ports_by_changing_its_import() {
+    if !numpy() {
+        return;
+    }
+    let example = repo("examples/samplers/mitsuba_style.py");
+    let out = scratch("mitsuba-style");
+    let go = |extra: &[&str]| {
+        let o = run(Command::new("python3")
+            .arg(&example)
+            .args(extra)
+            .arg(&out)
+            .env("DIRECTLAB", env!("CARGO_BIN_EXE_directlab")));
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        );
+        (o.status.success(), text)
+    };
+    let (ok, text) = go(&[]);
+    assert!(
+        ok && text.contains("cosine hemisphere: pass | disk: pass"),
+        "{text}"
+    );
+    assert!(out.join("sphere/heatmap.png").exists() && out.join("disk/heatmap.png").exists());
+    let (ok, text) = go(&["--wrong"]);
+    assert!(
+        !ok && text.contains("cosine hemisphere: FAIL | disk: pass"),
+        "{text}"
+    );
+    assert!(text.contains("integral: FAIL"), "{text}");
 }
