@@ -116,6 +116,9 @@ where
     let n_all = cfg.samples as usize;
     let mut points: Vec<Option<D::Point>> = Vec::with_capacity(n_all);
     let (mut claimed, mut weights) = (Vec::new(), Vec::new());
+    // The valid points as the program sent them: its pdf is asked about these, not about
+    // their f32 roundings (which may cross its support's edge).
+    let mut exact = Vec::new();
     let mut wcols = 0;
     let (mut left, mut k) = (n_all, 0);
     while left > 0 {
@@ -129,6 +132,7 @@ where
             let valid = row[pdim + 1] > 0.5;
             points.push(valid.then(|| D::Point::read(&row[..pdim])));
             if valid {
+                exact.extend_from_slice(&row[..pdim]);
                 claimed.push(row[pdim]);
                 weights.push(max_channel(&row[pdim + 2..]));
             }
@@ -145,10 +149,11 @@ where
             seen.data[r * ncol + c] += 1.0;
         }
     }
-    let at_samples = query(s, "pdf", &valid, &[1], "pdf phase at the samples")?;
+    let at_samples = query_rows(s, "pdf", &exact, pdim, &[1], "pdf phase at the samples")?;
     let mut checks = vec![claim_check(&claimed, &at_samples)];
     if bsdf {
-        let evals = query(s, "eval", &valid, &[1, 3], "eval phase at the samples")?;
+        let what = "eval phase at the samples";
+        let evals = query_rows(s, "eval", &exact, pdim, &[1, 3], what)?;
         let mut furnace = Welford::new();
         let mut wc = WeightCheck::default();
         for i in 0..valid.len() {
@@ -406,14 +411,26 @@ fn query<P: Coords>(
     cols: &[usize],
     what: &str,
 ) -> Result<Vec<f64>, String> {
-    let mut out = Vec::with_capacity(points.len());
-    for (k, chunk) in points.chunks(s.batch.max(1)).enumerate() {
-        let mut payload = Vec::with_capacity(chunk.len() * P::DIM);
-        for p in chunk {
-            p.write(&mut payload);
-        }
+    let mut rows = Vec::with_capacity(points.len() * P::DIM);
+    for p in points {
+        p.write(&mut rows);
+    }
+    query_rows(s, phase, &rows, P::DIM, cols, what)
+}
+
+/// [`query`] at points given as rows of `dim` f64.
+fn query_rows(
+    s: &mut Session,
+    phase: &str,
+    rows: &[f64],
+    dim: usize,
+    cols: &[usize],
+    what: &str,
+) -> Result<Vec<f64>, String> {
+    let mut out = Vec::with_capacity(rows.len() / dim);
+    for (k, chunk) in rows.chunks(s.batch.max(1) * dim).enumerate() {
         let what = format!("{what}, batch {k}");
-        let (v, c) = request(s, phase, &payload, chunk.len(), P::DIM, cols, &what)?;
+        let (v, c) = request(s, phase, chunk, chunk.len() / dim, dim, cols, &what)?;
         out.extend(v.chunks_exact(c).map(max_channel));
     }
     Ok(out)

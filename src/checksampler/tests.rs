@@ -152,3 +152,22 @@ fn validate_names_what_was_expected() {
     let e = validate(&json!({"count": 1, "cols": 1}), &[f64::INFINITY], 1, &[1]).unwrap_err();
     assert!(e.contains("non-finite value inf in row 0, column 0"), "{e}");
 }
+
+/// The pdf at a sample is asked at the point as the program sent it: a point 1e-13 inside a
+/// support edge is outside once rounded to f32, and the claimed pdf must still match.
+#[test]
+fn the_claimed_pdf_is_checked_at_the_exact_point() {
+    let third = 1.0 / 3.0;
+    assert!((third - 1e-13) as f32 as f64 > third, "the f32 rounding crosses the edge");
+    let pdf = move |x: f64| if x <= third { 3.0 } else { 0.0 };
+    let mut p = InProcess {
+        requests: Rc::default(),
+        answer: Box::new(move |phase, r| match phase {
+            "sample" => (vec![third - 1e-13, r[1], 3.0, 1.0], 4),
+            _ => (vec![pdf(r[0])], 1),
+        }),
+    };
+    let o = run(&mut p, &Target::Square, 3);
+    let claim = o.checks.iter().find(|c| c.name == "claimed pdf").unwrap();
+    assert!(claim.passed, "{}", claim.detail);
+}
