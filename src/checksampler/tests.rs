@@ -158,7 +158,10 @@ fn validate_names_what_was_expected() {
 #[test]
 fn the_claimed_pdf_is_checked_at_the_exact_point() {
     let third = 1.0 / 3.0;
-    assert!((third - 1e-13) as f32 as f64 > third, "the f32 rounding crosses the edge");
+    assert!(
+        (third - 1e-13) as f32 as f64 > third,
+        "the f32 rounding crosses the edge"
+    );
     let pdf = move |x: f64| if x <= third { 3.0 } else { 0.0 };
     let mut p = InProcess {
         requests: Rc::default(),

@@ -159,53 +159,62 @@ pub(crate) fn builtin_p_value(case: &str, samples: u64) -> f64 {
     p
 }
 
-#[test]
-fn directlab_warps_in_python_get_the_built_in_p_values() {
-    if !numpy() {
-        return;
-    }
-    let example = repo("examples/samplers/directlab_warps.py");
+/// Each of directlab's warps served by `program` followed by the warp's name gets the
+/// built-in case's p-value at 100,000 samples; returns each case's report.
+pub(crate) fn warps_get_the_built_in_p_values(program: &[&str]) -> Vec<String> {
+    let mut reports = Vec::new();
     for (case, warp) in WARPS {
-        let (ok, text) = check_with(
-            &["--case", case, "--samples", "100000"],
-            &["python3", example.to_str().unwrap(), warp],
-        );
+        let prog: Vec<&str> = program.iter().copied().chain([warp]).collect();
+        let (ok, text) = check_with(&["--case", case, "--samples", "100000"], &prog);
         assert!(ok, "{case}: {text}");
-        let p_program = number_after(&text, "p = ");
-        let p_builtin = builtin_p_value(case, 100_000);
+        let (p, builtin) = (number_after(&text, "p = "), builtin_p_value(case, 100_000));
         // The same points in the same cells: only the cell integration (batched through
         // the program's pdf, or recursive on directlab's) may move the statistic a little.
         assert!(
-            (p_program - p_builtin).abs() < 0.01,
-            "{case}: p {p_program} from the program, {p_builtin} built in"
+            (p - builtin).abs() < 0.01,
+            "{case}: p {p} from the program, {builtin} built in"
+        );
+        reports.push(text);
+    }
+    reports
+}
+
+/// The same warps' p-values over 20 seeds pass the KS test of uniformity (20,000 samples,
+/// resolution 21).
+pub(crate) fn warps_have_uniform_p_values_over_20_seeds(program: &[&str]) {
+    for (case, warp) in WARPS {
+        let prog: Vec<&str> = program.iter().copied().chain([warp]).collect();
+        let args = [
+            "--case",
+            case,
+            "--samples",
+            "20000",
+            "--resolution",
+            "21",
+            "--seeds",
+            "20",
+        ];
+        let (ok, text) = check_with(&args, &prog);
+        assert!(
+            ok && text.contains("uniform p-values: pass (20 seeds"),
+            "{case}: {text}"
         );
     }
 }
 
 #[test]
-fn directlab_warps_in_python_have_uniform_p_values_over_20_seeds() {
-    if !numpy() {
-        return;
+fn directlab_warps_in_python_get_the_built_in_p_values() {
+    if numpy() {
+        let example = repo("examples/samplers/directlab_warps.py");
+        warps_get_the_built_in_p_values(&["python3", example.to_str().unwrap()]);
     }
-    let example = repo("examples/samplers/directlab_warps.py");
-    for (case, warp) in WARPS {
-        let (ok, text) = check_with(
-            &[
-                "--case",
-                case,
-                "--samples",
-                "20000",
-                "--resolution",
-                "21",
-                "--seeds",
-                "20",
-            ],
-            &["python3", example.to_str().unwrap(), warp],
-        );
-        assert!(
-            ok && text.contains("uniform p-values: pass (20 seeds"),
-            "{case}: {text}"
-        );
+}
+
+#[test]
+fn directlab_warps_in_python_have_uniform_p_values_over_20_seeds() {
+    if numpy() {
+        let example = repo("examples/samplers/directlab_warps.py");
+        warps_have_uniform_p_values_over_20_seeds(&["python3", example.to_str().unwrap()]);
     }
 }
 

@@ -11,7 +11,10 @@
 //! Without a C++ compiler and Eigen the tests say so and are skipped, unless
 //! DIRECTLAB_REQUIRE_CPP=1 (set by `.ci/run` once scripts/install-cpp succeeded).
 
-use crate::check_sampler::{builtin_p_value, check_with, number_after, WARPS};
+use crate::check_sampler::{
+    check_with, number_after, warps_get_the_built_in_p_values,
+    warps_have_uniform_p_values_over_20_seeds, WARPS,
+};
 use crate::common::{repo, scratch};
 use std::path::PathBuf;
 use std::process::Command;
@@ -59,15 +62,8 @@ fn directlab_warps_in_cpp_get_the_built_in_p_values_over_both_transports() {
         return;
     }
     let bin = warps_binary();
-    for (case, warp) in WARPS {
-        let prog = [bin.to_str().unwrap(), warp];
-        let (ok, text) = check_with(&["--case", case, "--samples", "100000"], &prog);
-        assert!(ok, "{case}: {text}");
-        let (p, builtin) = (number_after(&text, "p = "), builtin_p_value(case, 100_000));
-        assert!(
-            (p - builtin).abs() < 0.01,
-            "{case}: {p} vs built-in {builtin}"
-        );
+    let piped = warps_get_the_built_in_p_values(&[bin.to_str().unwrap()]);
+    for ((case, warp), text) in WARPS.iter().zip(piped) {
         let args = [
             "--case",
             case,
@@ -76,39 +72,17 @@ fn directlab_warps_in_cpp_get_the_built_in_p_values_over_both_transports() {
             "--transport",
             "files",
         ];
-        let (ok, files) = check_with(&args, &prog);
+        let (ok, files) = check_with(&args, &[bin.to_str().unwrap(), warp]);
         assert!(ok, "{case}: {files}");
-        assert_eq!(
-            number_after(&files, "chi2 = "),
-            number_after(&text, "chi2 = ")
-        );
+        let chi2 = |t: &str| number_after(t, "chi2 = ");
+        assert_eq!(chi2(&files), chi2(&text), "{case}");
     }
 }
 
 #[test]
 fn directlab_warps_in_cpp_have_uniform_p_values_over_20_seeds() {
-    if !have_cpp() {
-        return;
-    }
-    let bin = warps_binary();
-    for (case, warp) in WARPS {
-        let (ok, text) = check_with(
-            &[
-                "--case",
-                case,
-                "--samples",
-                "20000",
-                "--resolution",
-                "21",
-                "--seeds",
-                "20",
-            ],
-            &[bin.to_str().unwrap(), warp],
-        );
-        assert!(
-            ok && text.contains("uniform p-values: pass (20 seeds"),
-            "{case}: {text}"
-        );
+    if have_cpp() {
+        warps_have_uniform_p_values_over_20_seeds(&[warps_binary().to_str().unwrap()]);
     }
 }
 
