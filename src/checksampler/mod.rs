@@ -6,6 +6,7 @@
 pub mod engine;
 pub mod files;
 pub mod npy;
+mod page;
 pub mod pipe;
 pub mod program;
 #[cfg(test)]
@@ -151,7 +152,7 @@ pub struct CheckSamplerArgs {
     /// Significance level of the test.
     #[arg(long, default_value_t = 0.01)]
     pub alpha: f64,
-    /// Where the heat map goes.
+    /// Where the heat maps, results.csv and index.html go.
     #[arg(long, default_value = "reports/check-sampler")]
     pub out: PathBuf,
     /// The sampler program and its arguments, after `--` (e.g. `-- python3 my_sampler.py`);
@@ -166,7 +167,7 @@ pub fn command(a: &CheckSamplerArgs) -> Result<(), String> {
     let verdict = |ok: bool| if ok { "pass" } else { "FAIL" };
     // With --transport stdio, stdout carries the protocol: the report goes to stderr.
     let mut text = String::new();
-    for (o, map) in &r.outcomes {
+    for (o, map, _) in &r.outcomes {
         text += &format!(
             "{}: {} ({}); heat map {}\n",
             o.name,
@@ -185,7 +186,7 @@ pub fn command(a: &CheckSamplerArgs) -> Result<(), String> {
         Transport::Stdio => eprint!("{text}"),
         _ => print!("{text}"),
     }
-    let failed = r.outcomes.iter().filter(|(o, _)| !o.passed()).count()
+    let failed = r.outcomes.iter().filter(|(o, _, _)| !o.passed()).count()
         + r.calibration.iter().filter(|(_, c)| !c.passed).count();
     let total = r.outcomes.len() + r.calibration.len();
     match failed {
@@ -199,7 +200,8 @@ pub fn command(a: &CheckSamplerArgs) -> Result<(), String> {
 /// What a run found: each check with its heat map, and with `--seeds` above 1, the test
 /// of each target's p-values for uniformity.
 pub struct Report {
-    pub outcomes: Vec<(Outcome, PathBuf)>,
+    /// Each check, its heat map and the seconds it took.
+    pub outcomes: Vec<(Outcome, PathBuf, f64)>,
     pub calibration: Vec<(String, Check)>,
 }
 
@@ -292,9 +294,10 @@ pub fn run(a: &CheckSamplerArgs) -> Result<Report, String> {
                 1 => job.name.clone(),
                 _ => format!("{} seed {}", job.name, a.seed + s),
             };
+            let start = std::time::Instant::now();
             let o = engine::check(&mut session, &cfg, &name)?;
             p_values.push(o.chi2.p_value);
-            outcomes.push(o);
+            outcomes.push((o, start.elapsed().as_secs_f64()));
         }
         if a.seeds > 1 {
             let level = crate::stats::sidak(a.alpha, jobs.len());
@@ -304,19 +307,36 @@ pub fn run(a: &CheckSamplerArgs) -> Result<Report, String> {
     program.finish();
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
     let mut out = Vec::new();
-    for (k, o) in outcomes.into_iter().enumerate() {
+    for (k, (o, seconds)) in outcomes.into_iter().enumerate() {
         let file = match runs {
             1 => "heatmap.png".to_string(),
             _ => format!("heatmap-{k}.png"),
         };
         let path = a.out.join(file);
         o.write_heatmap(&path)?;
-        out.push((o, path));
+        out.push((o, path, seconds));
     }
-    Ok(Report {
+    let report = Report {
         outcomes: out,
         calibration,
-    })
+    };
+    let program = match a.command.is_empty() {
+        true => "the process that started directlab".to_string(),
+        false => format!("`{}`", a.command.join(" ")),
+    };
+    let what = match &a.case {
+        Some(case) => format!("{program} in place of {case}"),
+        None => program,
+    };
+    let size = CaseConfig {
+        samples: a.samples,
+        resolution: a.resolution as usize,
+        seed: a.seed,
+        alpha,
+        ..CaseConfig::default()
+    };
+    page::write(&a.out, &report, &what, &size)?;
+    Ok(report)
 }
 
 /// The p-values of one target over seeds against Uniform(0, 1): KS at `alpha`.

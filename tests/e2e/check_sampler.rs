@@ -407,3 +407,40 @@ fn a_mitsuba_style_test_ports_by_changing_its_import() {
     );
     assert!(text.contains("integral: FAIL"), "{text}");
 }
+
+/// A run leaves the pages `directlab chi2` leaves: results.csv with a row per check, and
+/// index.html with the verdicts and the failure's heat map.
+#[test]
+fn a_run_writes_results_csv_and_a_page_with_the_failures() {
+    if !numpy() {
+        return;
+    }
+    let example = repo("examples/samplers/diffuse_bsdf.py");
+    let out = scratch("check-sampler-pages");
+    let o = run(directlab()
+        .args([
+            "check-sampler",
+            "--domain",
+            "bsdf",
+            "--samples",
+            "20000",
+            "--out",
+        ])
+        .arg(&out)
+        .args([
+            "--",
+            "python3",
+            example.to_str().unwrap(),
+            "--wrong",
+            "support",
+        ]));
+    assert!(!o.status.success());
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 5, "{csv}");
+    assert!(csv.contains("check-sampler/bsdf/wi=normal,") && csv.contains("furnace=fail"));
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(html.contains("check-sampler/bsdf/wi=grazing") && html.contains("FAIL"));
+    assert!(html.contains("<img"), "the failures' heat maps are shown");
+    let md = std::fs::read_to_string(out.join("index.md")).unwrap();
+    assert!(md.contains("](heatmap-0.png)") && md.contains("furnace: mean weight"));
+}
