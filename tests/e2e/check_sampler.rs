@@ -305,8 +305,14 @@ fn the_files_transport_gives_the_pipes_result_and_names_bad_replies() {
         ("import sys; sys.exit(4)", "exited: exit status: 4"),
         ("pass", "finished without writing"),
         (f32_reply, "expected little-endian float64 ('<f8')"),
+        (
+            "import time; time.sleep(30)",
+            "did not finish within 1 s (killed)",
+        ),
     ] {
-        let (ok, text) = check_with(&files_args, &["python3", "-c", program]);
+        let mut args = files_args.clone();
+        args.extend(["--timeout", "1"]);
+        let (ok, text) = check_with(&args, &["python3", "-c", program]);
         assert!(!ok && text.contains(words), "{program}: {text}");
         assert!(text.contains("sample phase, batch 0"), "{text}");
     }
