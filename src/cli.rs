@@ -50,6 +50,9 @@ pub enum Command {
     /// exits non-zero if it fails.
     #[command(after_long_help = crate::checksampler::HELP)]
     CheckSampler(crate::checksampler::CheckSamplerArgs),
+    /// Welch's t-test between two noisy renders (directories of seeds' EXRs, or EXRs with
+    /// variances): a p-value map and a verdict, with no reference; exits non-zero on a bias.
+    Compare(crate::compare::CompareArgs),
     /// Run Nori test files (`<test type="ttest">`, `<test type="chi2test">`): scenes against
     /// references per strategy, BSDF albedos, BSDF chi-square; exits non-zero on a failure.
     Test(crate::noritest::TestArgs),
@@ -381,6 +384,7 @@ pub fn main() -> i32 {
                 .ok_or_else(|| "some sampling routines do not match their pdfs".to_string())
         }),
         Command::CheckSampler(a) => crate::checksampler::command(a),
+        Command::Compare(a) => crate::compare::command(a),
         Command::Extreme(a) => cmd_extreme(a),
         Command::Labels => {
             print!("{}", crate::labels::grammar());

@@ -17,6 +17,7 @@ pub mod checksampler;
 pub mod chi2cases;
 pub mod choices;
 pub mod cli;
+pub mod compare;
 pub mod cost;
 pub mod experiment;
 pub mod integrands;

@@ -10,6 +10,7 @@ pub mod nnls;
 pub mod ratio;
 pub mod slope;
 pub mod ttest;
+pub mod welch_map;
 pub mod welford;
 
 pub use chi2::{chi2_test, Chi2Config, Chi2Result, Grid, Verdict};

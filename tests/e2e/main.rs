@@ -10,6 +10,7 @@ mod bench_cli;
 mod browser;
 mod check_sampler;
 mod check_sampler_cpp;
+mod compare_cli;
 mod experiment_cli;
 mod extreme;
 mod html_page;

@@ -1,0 +1,143 @@
+//! `directlab compare` end to end on the Cornell box at 64x64 (alpha 0.01, 8x8 tiles):
+//! two sets of six seeds at 16 spp agree; the same with B's light 3 % brighter (B's images
+//! scaled) is detected, exits non-zero and names the region; a single render with its
+//! variance against another agrees; bad input is named.
+
+use crate::common::{directlab, repo, run, scratch};
+use directlab::film::{read_exr, write_exr};
+use std::path::{Path, PathBuf};
+
+fn render(out: &Path, seed: u32, spp: u32, variance: Option<&Path>) {
+    let mut cmd = directlab();
+    cmd.arg("render")
+        .arg(repo("scenes/cbox/cbox.xml"))
+        .args([
+            "--spp",
+            &spp.to_string(),
+            "--seed",
+            &seed.to_string(),
+            "-D",
+            "res=64",
+        ])
+        .arg("--out")
+        .arg(out);
+    if let Some(v) = variance {
+        cmd.arg("--variance").arg(v);
+    }
+    let o = run(&mut cmd);
+    assert!(o.status.success(), "{o:?}");
+}
+
+fn seeds(dir: &Path, first: u32, scale: f64) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    for s in 0..6 {
+        let f = dir.join(format!("seed{s}.exr"));
+        render(&f, first + s, 16, None);
+        if scale != 1.0 {
+            let mut img = read_exr(&f).unwrap();
+            img.data
+                .iter_mut()
+                .for_each(|p| p.iter_mut().for_each(|c| *c *= scale));
+            write_exr(&f, &img).unwrap();
+        }
+    }
+    dir.to_path_buf()
+}
+
+fn compare(args: &[&std::ffi::OsStr]) -> (bool, String) {
+    let o = run(directlab().arg("compare").args(args));
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    (o.status.success(), text)
+}
+
+#[test]
+fn seeds_agree_and_a_three_percent_light_is_detected() {
+    let dir = scratch("compare-seeds");
+    let a = seeds(&dir.join("a"), 1, 1.0);
+    let b = seeds(&dir.join("b"), 101, 1.0);
+    let b3 = seeds(&dir.join("b3"), 201, 1.03);
+    let out = dir.join("out");
+    let (ok, text) = compare(&[
+        a.as_os_str(),
+        b.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert!(
+        ok && text.contains("no bias detected at alpha 0.01"),
+        "{text}"
+    );
+    assert!(out.join("index.html").exists() && out.join("p-tiles.png").exists());
+    let (ok, text) = compare(&[
+        a.as_os_str(),
+        b3.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert!(!ok && text.contains("bias detected"), "{text}");
+    let md = std::fs::read_to_string(out.join("index.md")).unwrap();
+    assert!(
+        md.contains("region 1:") && md.contains("A/B - 1 = -"),
+        "{md}"
+    );
+}
+
+#[test]
+fn single_renders_with_variances_agree_and_bad_input_is_named() {
+    let dir = scratch("compare-single");
+    let (a, av) = (dir.join("a.exr"), dir.join("a-var.exr"));
+    let (b, bv) = (dir.join("b.exr"), dir.join("b-var.exr"));
+    render(&a, 1, 64, Some(&av));
+    render(&b, 2, 64, Some(&bv));
+    let out = dir.join("out");
+    let mut args: Vec<&std::ffi::OsStr> = vec![a.as_os_str(), b.as_os_str()];
+    args.extend([
+        "--variance-a".as_ref(),
+        av.as_os_str(),
+        "--variance-b".as_ref(),
+    ]);
+    args.extend([
+        bv.as_os_str(),
+        "--spp-a".as_ref(),
+        "64".as_ref(),
+        "--spp-b".as_ref(),
+    ]);
+    args.extend(["64".as_ref(), "--out".as_ref(), out.as_os_str()]);
+    let (ok, text) = compare(&args);
+    assert!(ok && text.contains("no bias detected"), "{text}");
+    // No variance for a single render; one seed in a directory; different sizes.
+    let (ok, text) = compare(&[a.as_os_str(), b.as_os_str()]);
+    assert!(
+        !ok && text.contains("needs --variance-a and --spp-a"),
+        "{text}"
+    );
+    let one = dir.join("one");
+    std::fs::create_dir_all(&one).unwrap();
+    std::fs::copy(&a, one.join("s.exr")).unwrap();
+    let (ok, text) = compare(&[one.as_os_str(), one.as_os_str()]);
+    assert!(
+        !ok && text.contains("needs at least two seeds' EXRs"),
+        "{text}"
+    );
+    let small = dir.join("small.exr");
+    let mut img = read_exr(&a).unwrap();
+    img.width = 32;
+    img.height = 128;
+    write_exr(&small, &img).unwrap();
+    let mut args: Vec<&std::ffi::OsStr> = vec![small.as_os_str(), b.as_os_str()];
+    args.extend([
+        "--variance-a".as_ref(),
+        av.as_os_str(),
+        "--spp-a".as_ref(),
+        "64".as_ref(),
+    ]);
+    let (ok, text) = compare(&args);
+    assert!(
+        !ok && text.contains("64x64, but its image") && text.contains("is 32x128"),
+        "{text}"
+    );
+}
