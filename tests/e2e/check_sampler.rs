@@ -17,7 +17,7 @@
 //! `.ci/run` once numpy imports).
 
 use crate::common;
-use common::{directlab, repo, run, scratch};
+use common::{directlab, repo, run, run_text, scratch};
 use std::process::Command;
 
 fn numpy() -> bool {
@@ -46,19 +46,15 @@ pub(crate) fn check_with(args: &[&str], program: &[&str]) -> (bool, String) {
     static RUN: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let k = RUN.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
     let out = scratch(&format!("check-sampler-{k}"));
-    let o = run(directlab()
-        .arg("check-sampler")
-        .args(args)
-        .arg("--out")
-        .arg(&out)
-        .arg("--")
-        .args(program));
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    (o.status.success(), text)
+    run_text(
+        directlab()
+            .arg("check-sampler")
+            .args(args)
+            .arg("--out")
+            .arg(&out)
+            .arg("--")
+            .args(program),
+    )
 }
 
 #[test]
@@ -388,17 +384,13 @@ fn a_mitsuba_style_test_ports_by_changing_its_import() {
     let example = repo("examples/samplers/mitsuba_style.py");
     let out = scratch("mitsuba-style");
     let go = |extra: &[&str]| {
-        let o = run(Command::new("python3")
-            .arg(&example)
-            .args(extra)
-            .arg(&out)
-            .env("DIRECTLAB", env!("CARGO_BIN_EXE_directlab")));
-        let text = format!(
-            "{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        );
-        (o.status.success(), text)
+        run_text(
+            Command::new("python3")
+                .arg(&example)
+                .args(extra)
+                .arg(&out)
+                .env("DIRECTLAB", env!("CARGO_BIN_EXE_directlab")),
+        )
     };
     let (ok, text) = go(&[]);
     assert!(

@@ -15,7 +15,7 @@ use crate::check_sampler::{
     check_with, number_after, warps_get_the_built_in_p_values,
     warps_have_uniform_p_values_over_20_seeds, WARPS,
 };
-use crate::common::{repo, scratch};
+use crate::common::{repo, run_text, scratch};
 use std::path::PathBuf;
 use std::process::Command;
 use std::sync::OnceLock;
@@ -111,19 +111,12 @@ fn check_warps(warp_cpp: &str) -> (bool, String) {
         "check-warps-{}",
         warp_cpp.replace(['/', '.'], "-")
     ));
-    let o = Command::new(repo("helpers/nori/check-warps"))
-        .arg(repo(warp_cpp))
+    let mut cmd = Command::new(repo("helpers/nori/check-warps"));
+    cmd.arg(repo(warp_cpp))
         .args(["--samples", "100000", "--out"])
         .arg(&out)
-        .env("DIRECTLAB", env!("CARGO_BIN_EXE_directlab"))
-        .output()
-        .unwrap();
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    (o.status.success(), text)
+        .env("DIRECTLAB", env!("CARGO_BIN_EXE_directlab"));
+    run_text(&mut cmd)
 }
 
 #[test]

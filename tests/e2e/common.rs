@@ -34,6 +34,17 @@ pub fn run(cmd: &mut Command) -> Output {
     out
 }
 
+/// Runs `cmd`: whether it succeeded, and its stdout followed by its stderr.
+pub fn run_text(cmd: &mut Command) -> (bool, String) {
+    let o = cmd.output().expect("run the command");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    (o.status.success(), text)
+}
+
 /// A small sweep for the sharding tests (16x16 two-light box, a reference of three chunks,
 /// two strategies x three spp x two seeds, one equal-time budget), written into `dir`.
 pub fn tiny_experiment(dir: &Path, seeds: u32) -> PathBuf {

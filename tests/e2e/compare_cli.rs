@@ -3,7 +3,7 @@
 //! scaled) is detected, exits non-zero and names the region; a single render with its
 //! variance against another agrees; bad input is named.
 
-use crate::common::{directlab, repo, run, scratch};
+use crate::common::{directlab, repo, run, run_text, scratch};
 use directlab::film::{read_exr, write_exr};
 use std::path::{Path, PathBuf};
 
@@ -45,13 +45,7 @@ fn seeds(dir: &Path, first: u32, scale: f64) -> PathBuf {
 }
 
 fn compare(args: &[&std::ffi::OsStr]) -> (bool, String) {
-    let o = run(directlab().arg("compare").args(args));
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    (o.status.success(), text)
+    run_text(directlab().arg("compare").args(args))
 }
 
 #[test]
