@@ -13,7 +13,9 @@ use std::path::{Path, PathBuf};
 
 #[derive(clap::Args, Debug)]
 pub struct CompareArgs {
-    /// Side A: a directory of EXRs (one per seed), or one EXR with --variance-a and --spp-a.
+    /// Side A: a directory of EXRs (one per seed), or one EXR with --variance-a and --spp-a
+    /// (a render of independent samples only: for stratified, Sobol' or zsobol renders,
+    /// whose pixels' samples are correlated, give seeds).
     pub a: PathBuf,
     /// Side B, as A.
     pub b: PathBuf,
