@@ -158,6 +158,7 @@ pub fn run(a: &CompareArgs) -> Result<Verdict, String> {
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
     p_map_png(&a.out.join("p-pixels.png"), &pixels)?;
     p_map_png(&a.out.join("p-tiles.png"), &tiles)?;
+    write_tiles_csv(&a.out.join("tiles.csv"), &tiles)?;
     let hist = histogram(&tiles.p_values(), 20);
     let mut md =
         format!(
@@ -189,12 +190,14 @@ pub fn run(a: &CompareArgs) -> Result<Verdict, String> {
     }
     let _ = writeln!(
         md,
-        "\nExcluded (non-finite input): {} pixels, {} tiles.\n\n\
+        "\nExcluded (non-finite input): {} pixels, {} tiles; {} tile channels constant and \
+         equal on both sides, not tested.\n\n\
          Tile p-values, 20 bins from 0 to 1 (uniform when A and B converge to the same image): \
          {hist:?}\n\n## p-value maps\n\nBlack: p near 0; white: p near 1; red: excluded.\n\n\
          ![tiles](p-tiles.png)\n\n![pixels](p-pixels.png)",
         pixels.excluded(),
-        tiles.excluded()
+        tiles.excluded(),
+        tiles.constant
     );
     crate::report::write_report(&a.out, &md, None, Default::default())?;
     let summary = match regions.first() {
@@ -214,6 +217,35 @@ pub fn run(a: &CompareArgs) -> Result<Verdict, String> {
         ),
     };
     Ok(Verdict { biased, summary })
+}
+
+/// `tiles.csv`: per tile and channel, the p-value and A - B (empty where excluded).
+fn write_tiles_csv(path: &Path, m: &WelchMap) -> Result<(), String> {
+    let mut text = String::from("tile_x,tile_y,p_r,p_g,p_b,diff_r,diff_g,diff_b\n");
+    let cell = |x: f64| {
+        if x.is_nan() {
+            String::new()
+        } else {
+            format!("{x:.6e}")
+        }
+    };
+    for (i, (p, d)) in m.p.iter().zip(&m.diff).enumerate() {
+        let _ = writeln!(
+            text,
+            "{},{},{},{},{},{},{},{}",
+            i % m.width,
+            i / m.width,
+            cell(p[0]),
+            cell(p[1]),
+            cell(p[2]),
+            cell(d[0]),
+            cell(d[1]),
+            cell(d[2])
+        );
+    }
+    crate::output::write_atomic(path, |tmp| {
+        std::fs::write(tmp, &text).map_err(|e| format!("{}: {e}", path.display()))
+    })
 }
 
 /// Counts of `p` in `bins` equal bins of [0, 1].

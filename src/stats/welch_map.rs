@@ -115,6 +115,11 @@ pub struct WelchMap {
     pub diff: Vec<[f64; 3]>,
     /// Per unit, per channel: mean B (for relative differences).
     pub mean_b: Vec<[f64; 3]>,
+    /// Units with a non-finite input on either side (their channels are not tested).
+    pub nonfinite: usize,
+    /// Unit channels constant on both sides (zero variance: a light seen directly, a black
+    /// pixel) and equal: no evidence either way, so not tested (unequal constants are p 0).
+    pub constant: usize,
 }
 
 impl WelchMap {
@@ -123,7 +128,9 @@ impl WelchMap {
         assert_eq!((a.width, a.height), (b.width, b.height), "different grids");
         let mut p = Vec::with_capacity(a.mean.len());
         let mut diff = Vec::with_capacity(a.mean.len());
+        let (mut nonfinite, mut constant) = (0, 0);
         for i in 0..a.mean.len() {
+            let mut bad = false;
             let mut pi = [f64::NAN; 3];
             let mut di = [f64::NAN; 3];
             for c in 0..3 {
@@ -134,6 +141,12 @@ impl WelchMap {
                     b.var_mean[i][c],
                 );
                 if !(ma.is_finite() && va.is_finite() && mb.is_finite() && vb.is_finite()) {
+                    bad = true;
+                    continue;
+                }
+                di[c] = ma - mb;
+                if va == 0.0 && vb == 0.0 && ma == mb {
+                    constant += 1;
                     continue;
                 }
                 // Groups of n samples whose mean has variance v: sample variance v n.
@@ -148,8 +161,8 @@ impl WelchMap {
                     n: b.n,
                 };
                 pi[c] = welch(ga, gb).p_value;
-                di[c] = ma - mb;
             }
+            nonfinite += bad as usize;
             p.push(pi);
             diff.push(di);
         }
@@ -159,6 +172,8 @@ impl WelchMap {
             p,
             diff,
             mean_b: b.mean.clone(),
+            nonfinite,
+            constant,
         }
     }
 
@@ -174,10 +189,7 @@ impl WelchMap {
 
     /// Units excluded (a channel with a non-finite input).
     pub fn excluded(&self) -> usize {
-        self.p
-            .iter()
-            .filter(|p| p.iter().any(|x| x.is_nan()))
-            .count()
+        self.nonfinite
     }
 
     /// The per-test level that keeps the whole map at `alpha` (Sidak over every test).
@@ -185,13 +197,13 @@ impl WelchMap {
         sidak(alpha, self.p_values().len().max(1))
     }
 
-    /// Per unit, the smallest p-value of its channels (NaN when excluded).
+    /// Per unit, the smallest p-value of its tested channels (NaN when none was tested).
     pub fn min_p(&self) -> Vec<f64> {
         self.p
             .iter()
-            .map(|p| match p.iter().any(|x| x.is_nan()) {
-                true => f64::NAN,
-                false => p.iter().copied().fold(1.0, f64::min),
+            .map(|p| {
+                let tested = p.iter().copied().filter(|x| !x.is_nan());
+                tested.fold(f64::NAN, |m, x| if m.is_nan() { x } else { m.min(x) })
             })
             .collect()
     }
@@ -361,6 +373,21 @@ mod tests {
         }
     }
 
+    /// Channels constant and equal on both sides carry no evidence: not tested, counted.
+    #[test]
+    fn equal_constants_are_not_tested() {
+        let a = Side::from_seeds(2, 1, vec![vec![[1.0, 0.0, 2.0]; 2]; 3]);
+        let mut b = a.clone();
+        b.mean[1][2] = 3.0;
+        let m = WelchMap::new(&a, &b);
+        assert_eq!(m.constant, 5, "five equal constants");
+        assert_eq!(
+            m.p_values(),
+            vec![0.0],
+            "unequal constants are certainly different"
+        );
+    }
+
     #[test]
     fn non_finite_inputs_are_excluded_not_tested() {
         let mut rng = Rng::new(4, 0);
@@ -371,6 +398,6 @@ mod tests {
         let m = WelchMap::new(&a, &b);
         assert_eq!(m.excluded(), 1);
         assert_eq!(m.p_values().len(), 16 * 3 - 1);
-        assert!(m.min_p()[5].is_nan());
+        assert!(m.p[5][2].is_nan() && !m.min_p()[5].is_nan());
     }
 }

@@ -135,3 +135,62 @@ fn single_renders_with_variances_agree_and_bad_input_is_named() {
         "{text}"
     );
 }
+
+/// Calibration on real renders: 20 pairs of correct runs (Cornell box 32x32, four seeds of
+/// 4 spp per side, 4x4 tiles) give tile p-values uniform by KS (pooled over the pairs, about
+/// 3400 tests, at 0.01), and no pair reports a bias at alpha 0.01 over the 20 (Sidak: 5.0e-4
+/// each).
+#[test]
+fn twenty_correct_pairs_give_uniform_p_values_and_no_detection() {
+    let dir = scratch("compare-calibration");
+    let mut pooled = Vec::new();
+    let alpha = (1.0 - 0.99f64.powf(1.0 / 20.0)).to_string();
+    for pair in 0..20u32 {
+        let mut sides = Vec::new();
+        for side in 0..2u32 {
+            let d = dir.join(format!("pair{pair}-{side}"));
+            std::fs::create_dir_all(&d).unwrap();
+            for s in 0..4 {
+                let seed = 1000 * pair + 100 * side + s;
+                let o = run(directlab()
+                    .arg("render")
+                    .arg(repo("scenes/cbox/cbox.xml"))
+                    .args(["--spp", "4", "--seed", &seed.to_string(), "-D", "res=32"])
+                    .arg("--out")
+                    .arg(d.join(format!("s{s}.exr"))));
+                assert!(o.status.success());
+            }
+            sides.push(d);
+        }
+        let out = dir.join(format!("out{pair}"));
+        let (ok, text) = compare(&[
+            sides[0].as_os_str(),
+            sides[1].as_os_str(),
+            "--tile".as_ref(),
+            "4".as_ref(),
+            "--alpha".as_ref(),
+            alpha.as_ref(),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ]);
+        assert!(
+            ok && text.contains("no bias detected"),
+            "pair {pair}: {text}"
+        );
+        let csv = std::fs::read_to_string(out.join("tiles.csv")).unwrap();
+        for line in csv.lines().skip(1) {
+            let f: Vec<&str> = line.split(',').collect();
+            pooled.extend(f[2..5].iter().filter_map(|p| p.parse::<f64>().ok()));
+        }
+    }
+    // Channels constant on both sides (the light seen directly) are not tested.
+    assert!(
+        pooled.len() > 3000 && pooled.len() < 20 * 64 * 3,
+        "{}",
+        pooled.len()
+    );
+    pooled.sort_by(f64::total_cmp);
+    let d = directlab::stats::ks_uniform(&pooled);
+    let p = directlab::stats::ks_p_value(d, pooled.len());
+    assert!(p > 0.01, "KS distance {d}, p {p}");
+}
