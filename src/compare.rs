@@ -193,7 +193,8 @@ pub fn run(a: &CompareArgs) -> Result<Verdict, String> {
         "\nExcluded (non-finite input): {} pixels, {} tiles; {} tile channels constant and \
          equal on both sides, not tested.\n\n\
          Tile p-values, 20 bins from 0 to 1 (uniform when A and B converge to the same image): \
-         {hist:?}\n\n## p-value maps\n\nBlack: p near 0; white: p near 1; red: excluded.\n\n\
+         {hist:?}\n\n## p-value maps\n\nBlack: p near 0; white: p near 1; red: not tested \
+         (a non-finite input, or constant).\n\n\
          ![tiles](p-tiles.png)\n\n![pixels](p-pixels.png)",
         pixels.excluded(),
         tiles.excluded(),
@@ -258,7 +259,7 @@ fn histogram(p: &[f64], bins: usize) -> Vec<usize> {
 }
 
 /// The smallest p-value of each unit in grey (log scale: black at 1e-6 or below, white at
-/// 1), excluded units red.
+/// 1), untested units red.
 fn p_map_png(path: &Path, m: &WelchMap) -> Result<(), String> {
     let rgb: Vec<u8> = m
         .min_p()
