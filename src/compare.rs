@@ -159,7 +159,8 @@ pub fn run(a: &CompareArgs) -> Result<Verdict, String> {
     p_map_png(&a.out.join("p-pixels.png"), &pixels)?;
     p_map_png(&a.out.join("p-tiles.png"), &tiles)?;
     write_tiles_csv(&a.out.join("tiles.csv"), &tiles)?;
-    let hist = histogram(&tiles.p_values(), 20);
+    let tested = tiles.p_values();
+    let hist = histogram(&tested, 20);
     let mut md =
         format!(
         "# compare: {} against {}\n\n{}x{} pixels; side A {} samples, side B {}; {k}x{k} tiles; \
@@ -171,7 +172,7 @@ pub fn run(a: &CompareArgs) -> Result<Verdict, String> {
         sa.n,
         sb.n,
         a.alpha,
-        tiles.p_values().len(),
+        tested.len(),
         if biased { "Bias detected." } else { "No bias detected." }
     );
     for (i, r) in regions.iter().take(5).enumerate() {
@@ -205,8 +206,8 @@ pub fn run(a: &CompareArgs) -> Result<Verdict, String> {
         None => format!(
             "no bias detected at alpha {} ({} tile tests; smallest p {:.3e} vs {level:.3e})",
             a.alpha,
-            tiles.p_values().len(),
-            tiles.p_values().iter().copied().fold(1.0, f64::min)
+            tested.len(),
+            tested.iter().copied().fold(1.0, f64::min)
         ),
         Some(r) => format!(
             "bias detected: {} region(s); the largest, {} tiles, differs by {:+.3} % (A/B - 1); \

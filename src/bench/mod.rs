@@ -47,9 +47,8 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
     pub repeat: u32,
     /// Samples per pixel of each timed render of the triangle and emitter sweeps (64x64
-    /// pixels). At 64 spp a render lasted 25-60 ms and its speed spread by up to 50 % between
-    /// repetitions on this VM (scheduler ticks, thread start-up), which best-of-5 did not
-    /// remove; at 512 (0.2-0.4 s) the spread is 3-6 %.
+    /// pixels): renders much shorter than a scheduler tick's and a thread start-up's noise
+    /// spread too widely between repetitions for best-of-N to remove.
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
     pub sweep_spp: u32,
     /// Largest triangle count of the triangle-scaling sweep (1e3, 1e4, ... up to this).

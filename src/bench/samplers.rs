@@ -1,7 +1,7 @@
 //! Render throughput per sampler: every sampler with the goals' estimator (power-heuristic
 //! MIS) at the most threads, timed in turns, and each one's speed against the independent
-//! sampler's as the median of its paired repetitions (issue 45's goal: Owen-scrambled Sobol'
-//! at most 1.3x slower per sample than independent on the Cornell box).
+//! sampler's as the median of its paired repetitions, so a sampler's cost per sample is read
+//! against the cheapest one on the same machine at the same moment.
 
 use super::timing::sampler_throughputs;
 use super::{paired_ratio, power_mis, BenchArgs, Row};

@@ -150,6 +150,7 @@ where
         }
     }
     let at_samples = query_rows(s, "pdf", &exact, pdim, &[1], "pdf phase at the samples")?;
+    let (grid, albedo) = integrals(s, cfg, domain, &measure, bsdf, &seen)?;
     let mut checks = vec![claim_check(&claimed, &at_samples)];
     if bsdf {
         let what = "eval phase at the samples";
@@ -157,15 +158,12 @@ where
         let mut furnace = Welford::new();
         let mut wc = WeightCheck::default();
         for i in 0..valid.len() {
-            let w = if wcols > 0 {
-                weights[i]
-            } else {
-                evals[i] / claimed[i]
-            };
             if wcols > 0 {
-                wc.record(w, evals[i], claimed[i], at_samples[i]);
+                wc.record(weights[i], evals[i], claimed[i], at_samples[i]);
+                furnace.push(weights[i]);
+            } else {
+                furnace.push(evals[i] / claimed[i]);
             }
-            furnace.push(w);
         }
         for _ in valid.len()..n_all {
             furnace.push(0.0);
@@ -174,11 +172,9 @@ where
         if wcols > 0 && !valid.is_empty() {
             checks.push(wc.check());
         }
-        let albedo = integrals(s, cfg, domain, &measure, bsdf, &seen)?.1;
         checks.extend(furnace_checks(&furnace, albedo, cfg.alpha));
     }
-    // 3. Cell masses from the adaptive integration, then the chi-square test.
-    let grid = integrals(s, cfg, domain, &measure, bsdf, &seen)?.0;
+    // 3. The chi-square test against the cell masses.
     let queue = RefCell::new(points.into_iter());
     let mut o = run_given(
         name,

@@ -36,7 +36,8 @@ fn rim_normals(alpha: (f32, f32)) -> Vec<DVec3> {
         .collect()
 }
 
-fn narrow(alpha: (f32, f32)) -> bool {
+/// Whether a distribution of roughness `alpha` is tested in a window (see [`normal_window`]).
+pub fn narrow(alpha: (f32, f32)) -> bool {
     alpha.0.max(alpha.1) < WINDOW_BELOW_ALPHA
 }
 

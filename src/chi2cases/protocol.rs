@@ -4,7 +4,7 @@
 //! grid, from the same random numbers, so a program implementing the same warp gets the same
 //! p-value as the built-in case.
 
-use super::lobe::{normal_window, WINDOW_MAX_DEPTH};
+use super::lobe::{narrow, normal_window, WINDOW_MAX_DEPTH};
 use super::tangent::Tangent;
 use super::CaseConfig;
 use crate::sampling::microfacet::MicrofacetDistribution;
@@ -104,7 +104,7 @@ impl Target {
     /// distributions refine no deeper than [`WINDOW_MAX_DEPTH`] (see [`super::lobe`]).
     pub fn config(&self, cfg: &CaseConfig) -> CaseConfig {
         let mut cfg = *cfg;
-        if let (Target::Normals { .. }, AnyDomain::Window(_)) = (self, self.domain(&cfg)) {
+        if matches!(self, Target::Normals { alpha, .. } if narrow(*alpha)) {
             cfg.integration.max_depth = cfg.integration.max_depth.min(WINDOW_MAX_DEPTH);
         }
         cfg
