@@ -27,6 +27,7 @@ pub mod noritest;
 pub mod pipeline;
 pub mod plot;
 pub mod progress;
+pub mod render_cmd;
 #[cfg(test)]
 mod render_tests;
 pub mod report;

@@ -120,6 +120,11 @@ pub struct WelchMap {
     /// Unit channels constant on both sides (zero variance: a light seen directly, a black
     /// pixel) and equal: no evidence either way, so not tested (unequal constants are p 0).
     pub constant: usize,
+    /// Per unit: a tested channel had one side constant (zero variance) and the other not.
+    /// Its variance is then unknown, not zero: at low counts a heavy-tailed side (BSDF
+    /// sampling of a small light) often shows no hit at all, so such a unit's p-value alone
+    /// is no evidence of bias.
+    pub one_sided: Vec<bool>,
 }
 
 impl WelchMap {
@@ -129,8 +134,9 @@ impl WelchMap {
         let mut p = Vec::with_capacity(a.mean.len());
         let mut diff = Vec::with_capacity(a.mean.len());
         let (mut nonfinite, mut constant) = (0, 0);
+        let mut one_sided = Vec::with_capacity(a.mean.len());
         for i in 0..a.mean.len() {
-            let mut bad = false;
+            let (mut bad, mut one) = (false, false);
             let mut pi = [f64::NAN; 3];
             let mut di = [f64::NAN; 3];
             for c in 0..3 {
@@ -149,6 +155,7 @@ impl WelchMap {
                     constant += 1;
                     continue;
                 }
+                one |= (va == 0.0) != (vb == 0.0);
                 // Groups of n samples whose mean has variance v: sample variance v n.
                 let ga = Group {
                     mean: ma,
@@ -163,6 +170,7 @@ impl WelchMap {
                 pi[c] = welch(ga, gb).p_value;
             }
             nonfinite += bad as usize;
+            one_sided.push(one);
             p.push(pi);
             diff.push(di);
         }
@@ -174,6 +182,7 @@ impl WelchMap {
             mean_b: b.mean.clone(),
             nonfinite,
             constant,
+            one_sided,
         }
     }
 
@@ -224,11 +233,13 @@ impl WelchMap {
                 units: 0,
                 bbox: [usize::MAX, usize::MAX, 0, 0],
                 rel_diff: 0.0,
+                one_sided: true,
             };
             let (mut sum_d, mut sum_b) = (0.0, 0.0);
             while let Some(i) = stack.pop() {
                 let (x, y) = (i % self.width, i / self.width);
                 r.units += 1;
+                r.one_sided &= self.one_sided[i];
                 r.bbox = [
                     r.bbox[0].min(x),
                     r.bbox[1].min(y),
@@ -274,8 +285,10 @@ pub struct Region {
     pub units: usize,
     /// [x0, y0, x1, y1], inclusive, in units (pixels or tiles).
     pub bbox: [usize; 4],
-    /// Sum over the region of (A - B) over the sum of B.
+    /// Sum over the region of (A - B) over the sum of B (NaN where B sums to 0).
     pub rel_diff: f64,
+    /// Every unit of the region is one-sided (see [`WelchMap::one_sided`]).
+    pub one_sided: bool,
 }
 
 #[cfg(test)]
@@ -399,5 +412,27 @@ mod tests {
         assert_eq!(m.excluded(), 1);
         assert_eq!(m.p_values().len(), 16 * 3 - 1);
         assert!(m.p[5][2].is_nan() && !m.min_p()[5].is_nan());
+    }
+
+    /// A side that never saw a rare contribution (all seeds 0) against one that did: the
+    /// tile is significant but one-sided, and so is its region; a shift where both sides
+    /// vary is not.
+    #[test]
+    fn a_side_of_equal_seeds_makes_its_region_one_sided() {
+        let mut rng = Rng::new(5, 0);
+        let rare = Side::from_seeds(4, 4, images(&mut rng, 4, (4, 4), |_, _| 5.0, 0.5));
+        let zero = Side::from_seeds(4, 4, vec![vec![[0.0; 3]; 16]; 4]);
+        let m = WelchMap::new(&rare, &zero);
+        assert!(m.one_sided.iter().all(|x| *x));
+        let r = m.regions(m.level(0.01));
+        assert!(
+            r.len() == 1 && r[0].one_sided && r[0].rel_diff.is_nan(),
+            "{r:?}"
+        );
+        let shifted = Side::from_seeds(4, 4, images(&mut rng, 4, (4, 4), |_, _| 3.0, 0.5));
+        let m = WelchMap::new(&rare, &shifted);
+        let r = m.regions(m.level(0.01));
+        assert!(!m.one_sided.iter().any(|x| *x));
+        assert!(!r.is_empty() && !r[0].one_sided, "{r:?}");
     }
 }
