@@ -6,8 +6,8 @@
 // The renderer's modules, under the paths the harness has always used (`crate::scene`, ...).
 // The compiler keeps the boundary: the renderer crate cannot name anything below.
 pub use directlab_render::{
-    bsdf, camera, counts, emitter, film, fnv, geometry, integrator, limits, math, memory, named,
-    output, render, rng, sampler, sampling, scene, RENDERER_HASH,
+    aov, bsdf, camera, counts, emitter, film, fnv, geometry, integrator, limits, math, memory,
+    named, output, render, rng, sampler, sampling, scene, RENDERER_HASH,
 };
 
 pub mod analytic;

@@ -1,6 +1,7 @@
 //! `directlab render`: one image of a scene, with its variance and statistics; and the same
 //! render for other commands (`compare` renders seeds of two configurations through it).
 
+use crate::aov::Aov;
 use crate::choices::{named, StrategyArgs};
 use crate::film;
 use crate::integrator::Strategy;
@@ -37,6 +38,13 @@ pub struct RenderArgs {
     /// Also write the per-pixel variance of the estimate (sample variance / spp) as EXR.
     #[arg(long)]
     pub variance: Option<PathBuf>,
+    /// Also write what each pixel's estimate is made of into this directory, as EXR with PNG
+    /// previews: emitted, light and bsdf (the parts of the image from the emission seen, the
+    /// light and the BSDF technique; they add up to it), weight-light and weight-bsdf (the
+    /// mean MIS weight of each technique's samples that carry light) and second-moment. A
+    /// second, scalar pass over the same samples.
+    #[arg(long)]
+    pub aov: Option<PathBuf>,
     /// Set a scene parameter declared with <default>: -D name=value (repeatable).
     #[arg(short = 'D', value_parser = crate::scene::loader::parse_define)]
     pub define: Vec<(String, String)>,
@@ -103,6 +111,12 @@ fn render_outputs(a: &RenderArgs) -> Result<PathBuf, String> {
         outputs.push(("--stats", s));
     }
     crate::output::check_distinct(&outputs)?;
+    if let Some(d) = a.aov.as_deref().filter(|d| d.exists() && !d.is_dir()) {
+        return Err(format!(
+            "--aov {}: a file; expected a directory for the images",
+            d.display()
+        ));
+    }
     for (_, p) in &outputs {
         crate::output::check_writable(p)?;
     }
@@ -115,7 +129,7 @@ pub fn render_args(
     a: &RenderArgs,
     seed: Option<u64>,
     progress: bool,
-) -> Result<(RenderOutput, RenderStats), String> {
+) -> Result<(RenderOutput, RenderStats, Option<Aov>), String> {
     let scene = crate::scene::open_with(&a.scene, &a.define, a.integrator)?;
     let strategy = a
         .strategy
@@ -135,6 +149,10 @@ pub fn render_args(
     };
     settings.sampler_config((scene.camera.width, scene.camera.height))?;
     let result = render(&scene, strategy, &settings);
+    let aov = a
+        .aov
+        .is_some()
+        .then(|| crate::aov::render_aov(&scene, strategy, &settings));
     let stats = RenderStats {
         scene: a.scene.display().to_string(),
         strategy: strategy.label(),
@@ -151,13 +169,13 @@ pub fn render_args(
         mean_rgb: result.mean.mean_rgb(),
         direct_part_of: scene.desc.integrator.direct_part_of.clone(),
     };
-    Ok((result, stats))
+    Ok((result, stats, aov))
 }
 
 /// The command.
 pub fn command(a: &RenderArgs) -> Result<(), String> {
     let out = render_outputs(a)?;
-    let (result, stats) = render_args(a, None, true)?;
+    let (result, stats, aov) = render_args(a, None, true)?;
     // The image, its preview, variance and statistics replace the old ones as one set: a
     // disk that fills part-way leaves the old files, never a new EXR beside an old PNG.
     crate::output::as_one_set(|| {
@@ -165,6 +183,13 @@ pub fn command(a: &RenderArgs) -> Result<(), String> {
         film::write_png(&out.with_extension("png"), &result.mean)?;
         if let Some(v) = &a.variance {
             film::write_exr(v, &result.variance)?;
+        }
+        if let (Some(dir), Some(aov)) = (&a.aov, &aov) {
+            std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+            for (name, img) in aov.images() {
+                film::write_exr(&dir.join(format!("{name}.exr")), img)?;
+                film::write_png(&dir.join(format!("{name}.png")), img)?;
+            }
         }
         if let Some(p) = &a.stats {
             let json = serde_json::to_string_pretty(&stats).map_err(|e| e.to_string())?;

@@ -111,6 +111,7 @@ pub(super) fn render_line(line: &str, name: &str) -> Result<crate::render_cmd::R
         (a.variance.is_some(), "--variance"),
         (a.stats.is_some(), "--stats"),
         (a.seed.is_some(), "--seed"),
+        (a.aov.is_some(), "--aov"),
     ] {
         if given {
             return Err(format!(
@@ -148,7 +149,7 @@ pub(super) fn render_side(
     let mut seconds = 0.0;
     let mut line = String::new();
     for i in 0..seeds {
-        let (out, stats) = crate::render_cmd::render_args(a, Some(first + i), false)?;
+        let (out, stats, _) = crate::render_cmd::render_args(a, Some(first + i), false)?;
         if out.non_finite_samples > 0 {
             return Err(format!(
                 "side {name}, seed {}: {} non-finite samples: the render is not an estimate \

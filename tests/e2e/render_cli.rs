@@ -219,3 +219,55 @@ fn defines_override_defaults() {
         .unwrap();
     assert!(!bad.status.success());
 }
+
+/// `render --aov DIR` on the Cornell box (32x32, 8 spp, power MIS): the six images exist
+/// with previews; emitted + light + bsdf is the image (to the EXR's f32 rounding, 1e-5
+/// relative); the MIS weights are in [0, 1]; the image itself is bitwise the one rendered
+/// without --aov. A file given as the directory is refused by name.
+#[test]
+fn aov_images_add_up_to_the_image() {
+    let d = scratch("aov");
+    let render = |out: &Path, aov: Option<&Path>| {
+        let mut cmd = directlab();
+        cmd.args(["render", repo("scenes/cbox/cbox.xml").to_str().unwrap()])
+            .args(["--spp", "8", "-D", "res=32", "--out"])
+            .arg(out);
+        if let Some(a) = aov {
+            cmd.arg("--aov").arg(a);
+        }
+        run(&mut cmd)
+    };
+    let aov = d.join("aov");
+    let o = render(&d.join("with.exr"), Some(&aov));
+    assert!(o.status.success(), "{o:?}");
+    assert!(render(&d.join("without.exr"), None).status.success());
+    assert_eq!(
+        std::fs::read(d.join("with.exr")).unwrap(),
+        std::fs::read(d.join("without.exr")).unwrap()
+    );
+    let img = read_exr(&d.join("with.exr")).unwrap();
+    let part = |n: &str| read_exr(&aov.join(format!("{n}.exr"))).unwrap().data;
+    let (e, l, b) = (part("emitted"), part("light"), part("bsdf"));
+    for (i, m) in img.data.iter().enumerate() {
+        for c in 0..3 {
+            let sum = e[i][c] + l[i][c] + b[i][c];
+            assert!((sum - m[c]).abs() <= 1e-5 * m[c].max(1e-3), "pixel {i}");
+        }
+    }
+    for w in ["weight-light", "weight-bsdf"] {
+        assert!(part(w).iter().all(|p| (0.0..=1.0).contains(&p[0])), "{w}");
+        assert!(aov.join(format!("{w}.png")).exists());
+    }
+    assert!(part("second-moment")
+        .iter()
+        .zip(&img.data)
+        .all(|(s, m)| s[0] >= m[0] * m[0] * 0.99999));
+    let file = d.join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let o = render(&d.join("x.exr"), Some(&file));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("expected a directory"),
+        "{err}"
+    );
+}

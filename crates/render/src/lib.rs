@@ -49,6 +49,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![deny(missing_docs)]
 
+pub mod aov;
 pub mod bsdf;
 pub mod build_key;
 pub mod camera;

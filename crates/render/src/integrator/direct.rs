@@ -10,7 +10,7 @@ use super::Strategy;
 use crate::bsdf::{BsdfSample, Material};
 use crate::counts::Counts;
 use crate::emitter::{EmitterSelector, LightSample};
-use crate::geometry::{Hit, Ray, SurfacePoint};
+use crate::geometry::{Hit, SurfacePoint};
 use crate::math::{luminance, Frame, Rgb};
 use crate::sampler::{LightDims, Sampler};
 use crate::scene::desc::Heuristic;
@@ -88,6 +88,35 @@ impl Weight {
             Weight::Mis { h, own, other } => heuristic(h, own * p, other * q),
             Weight::OneSample { h, own, other } => heuristic(h, own * p, other * q) / own,
         }
+    }
+
+    /// The MIS weight in a weight `w = self.at(p, q)`: w without one-sample MIS's division
+    /// by the technique's probability.
+    pub(super) fn mis_part(self, w: f32) -> f32 {
+        match self {
+            Weight::OneSample { own, .. } => w * own,
+            _ => w,
+        }
+    }
+}
+
+/// A sample that carries light, before its weight: `f * (w / div)` with w = weight(p, q),
+/// p its own technique's density and q the other's (`div` is 1 for BSDF samples, whose `f`
+/// is already divided by their density).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Term {
+    pub(super) f: Rgb,
+    pub(super) div: f32,
+    pub(super) p: f32,
+    pub(super) q: f32,
+}
+
+impl Term {
+    /// The weighted value and the weight.
+    #[inline(always)]
+    pub(super) fn weighted(self, weight: Weight) -> (Rgb, f32) {
+        let w = weight.at(self.p, self.q);
+        (self.f * (w / self.div), w)
     }
 }
 
@@ -212,21 +241,6 @@ impl<'a> Direct<'a> {
         }
     }
 
-    /// One light-technique sample. `weight(p_light, p_bsdf)` is its MIS weight divided by the
-    /// technique's selection probability; a delta light is asked with p_bsdf = 0, since no
-    /// other technique can produce it.
-    #[inline]
-    pub(super) fn light_sample(
-        &self,
-        sh: &Shading,
-        rng: &mut impl Sampler,
-        weight: Weight,
-        c: &mut Counts,
-    ) -> Rgb {
-        let drawn = self.light_draw(sh, rng, c);
-        self.light_finish(sh, drawn, weight, c)
-    }
-
     /// The random half of a light sample: the emitter, its point and density.
     #[inline(always)]
     pub(super) fn light_draw(
@@ -331,46 +345,34 @@ impl<'a> Direct<'a> {
             .map(|(drawn, dims)| (dims, drawn.p_div))
     }
 
-    /// The rest of a light sample: BSDF, visibility and weight.
+    /// The rest of a light sample: BSDF and visibility; its term before the weight
+    /// `weight(p_light, p_bsdf)` (its MIS weight divided by the technique's selection
+    /// probability; a delta light has p_bsdf = 0, since no other technique can produce it).
+    /// None: it carries no light.
     #[inline(always)]
-    pub(super) fn light_finish(
+    pub(super) fn light_term(
         &self,
         sh: &Shading,
         drawn: Option<LightDraw>,
-        weight: Weight,
         c: &mut Counts,
-    ) -> Rgb {
-        let Some(LightDraw { ls, pmf, p_div }) = drawn else {
-            return Rgb::ZERO;
-        };
+    ) -> Option<Term> {
+        let LightDraw { ls, pmf, p_div } = drawn?;
         let wo = sh.frame.to_local(ls.wi);
         c.bsdf_evals += 1;
         let (f, pdf) = sh.mat.eval_pdf(sh.wi, wo);
         if f == Rgb::ZERO || ls.li == Rgb::ZERO {
-            return Rgb::ZERO;
+            return None;
         }
         c.shadow_rays += 1;
         if !self.scene.visible(&sh.sp, &ls) {
-            return Rgb::ZERO;
+            return None;
         }
-        let p_light = pmf * ls.pdf;
-        let p_bsdf = if ls.delta { 0.0 } else { pdf };
-        let w = weight.at(p_light, p_bsdf);
-        f * ls.li * (w / p_div)
-    }
-
-    /// One BSDF-technique sample: follow the sampled direction and collect emission there.
-    /// Delta lobes are asked for their weight with p_light = 0 (light sampling cannot hit them).
-    #[inline]
-    pub(super) fn bsdf_sample(
-        &self,
-        sh: &Shading,
-        rng: &mut impl Sampler,
-        weight: Weight,
-        c: &mut Counts,
-    ) -> Rgb {
-        let drawn = self.bsdf_draw(sh, rng, c);
-        self.bsdf_finish(sh, drawn, weight, c)
+        Some(Term {
+            f: f * ls.li,
+            div: p_div,
+            p: pmf * ls.pdf,
+            q: if ls.delta { 0.0 } else { pdf },
+        })
     }
 
     /// The random half of a BSDF sample.
@@ -386,48 +388,62 @@ impl<'a> Direct<'a> {
         sh.mat.sample(sh.wi, u.lobe, u.direction)
     }
 
-    /// The rest of a BSDF sample: its ray, the emitter it reaches and the weight.
+    /// The rest of a BSDF sample: its ray and the emitter it reaches; its term before the
+    /// weight `weight(p_bsdf, p_light)` (a delta lobe has p_light = 0: light sampling cannot
+    /// hit it). None: it carries no light.
     #[inline(always)]
-    pub(super) fn bsdf_finish(
+    pub(super) fn bsdf_term(
         &self,
         sh: &Shading,
         drawn: Option<BsdfSample>,
-        weight: Weight,
         c: &mut Counts,
-    ) -> Rgb {
+    ) -> Option<Term> {
         let scene = self.scene;
-        let Some(bs) = drawn else {
-            return Rgb::ZERO;
-        };
+        let bs = drawn?;
         let d = sh.frame.to_world(bs.wo);
         let (ray, emitter_skip) = scene.bsdf_ray(&sh.sp, d);
-        self.bsdf_arrive(&sh.sp, &ray, emitter_skip, &bs, weight, c)
-    }
-
-    /// A BSDF sample's ray from `from` traced: the emission it reaches, weighted.
-    #[inline(always)]
-    pub(super) fn bsdf_arrive(
-        &self,
-        from: &SurfacePoint,
-        ray: &Ray,
-        emitter_skip: u32,
-        bs: &BsdfSample,
-        weight: Weight,
-        c: &mut Counts,
-    ) -> Rgb {
-        let scene = self.scene;
-        if !scene.bsdf_ray_may_hit(ray) {
+        if !scene.bsdf_ray_may_hit(&ray) {
             c.bsdf_rejected += 1;
-            return Rgb::ZERO;
+            return None;
         }
         c.bsdf_rays += 1;
-        match scene.bsdf_ray_hit_traced(ray, emitter_skip) {
-            Some(hit) => self.bsdf_emission(from, ray.d, &hit, bs, weight, c),
-            None => Rgb::ZERO,
-        }
+        let hit = scene.bsdf_ray_hit_traced(&ray, emitter_skip)?;
+        self.bsdf_emission_term(&sh.sp, ray.d, &hit, &bs, c)
     }
 
-    /// `bsdf_arrive` once its ray (from `from`, direction `d`) has hit `hit`.
+    /// `bsdf_term` once its ray (from `from`, direction `d`) has hit `hit`.
+    #[inline(always)]
+    fn bsdf_emission_term(
+        &self,
+        from: &SurfacePoint,
+        d: Vec3,
+        hit: &Hit,
+        bs: &BsdfSample,
+        c: &mut Counts,
+    ) -> Option<Term> {
+        let scene = self.scene;
+        let (ei, e) = scene.emitter_at(&hit.sp)?;
+        let le = e.le(&hit.sp, -d);
+        if le == Rgb::ZERO {
+            return None;
+        }
+        let p_light = if bs.delta {
+            0.0
+        } else {
+            c.light_pdf_evals += 1;
+            c.choice_evals += self.selector.evaluations();
+            self.selector.pmf(from.p, from.ns, ei)
+                * e.pdf(&scene.shapes, from.p, &hit.sp, self.strategy.light_sampling)
+        };
+        Some(Term {
+            f: bs.weight * le,
+            div: 1.0,
+            p: bs.pdf,
+            q: p_light,
+        })
+    }
+
+    /// `bsdf_emission_term` weighted (for the lanes that finish a BSDF sample one by one).
     #[inline(always)]
     pub(super) fn bsdf_emission(
         &self,
@@ -438,24 +454,8 @@ impl<'a> Direct<'a> {
         weight: Weight,
         c: &mut Counts,
     ) -> Rgb {
-        let scene = self.scene;
-        let Some((ei, e)) = scene.emitter_at(&hit.sp) else {
-            return Rgb::ZERO;
-        };
-        let le = e.le(&hit.sp, -d);
-        if le == Rgb::ZERO {
-            return Rgb::ZERO;
-        }
-        let p_light = if bs.delta {
-            0.0
-        } else {
-            c.light_pdf_evals += 1;
-            c.choice_evals += self.selector.evaluations();
-            self.selector.pmf(from.p, from.ns, ei)
-                * e.pdf(&scene.shapes, from.p, &hit.sp, self.strategy.light_sampling)
-        };
-        let w = weight.at(bs.pdf, p_light);
-        bs.weight * le * w
+        self.bsdf_emission_term(from, d, hit, bs, c)
+            .map_or(Rgb::ZERO, |t| t.weighted(weight).0)
     }
 }
 

@@ -11,6 +11,7 @@ pub use direct::Direct;
 #[cfg(test)]
 pub(crate) use lanes::Paths;
 pub use lanes::{LaneKernel, LaneScratch};
+pub use strategies::Record;
 pub use strategy::{Strategy, StrategyOverrides};
 
 #[cfg(test)]

@@ -22,6 +22,7 @@ use crate::math::Rgb;
 use crate::named::Named;
 use crate::sampler::Sampler;
 use crate::scene::desc::StrategyKind;
+pub use techniques::Record;
 pub(super) use techniques::{First, One, Techniques};
 
 /// An estimator of the light a camera ray's hit receives directly, written once against
@@ -84,9 +85,20 @@ impl Direct<'_> {
 
     /// `li`, adding what it did to `c` (the camera ray included).
     pub fn li_counted(&self, ray: &Ray, rng: &mut impl Sampler, c: &mut Counts) -> Rgb {
+        self.li_recorded(ray, rng, c, &mut ())
+    }
+
+    /// `li_counted`, telling `rec` what the estimate is made of.
+    pub fn li_recorded(
+        &self,
+        ray: &Ray,
+        rng: &mut impl Sampler,
+        c: &mut Counts,
+        rec: &mut impl Record,
+    ) -> Rgb {
         c.camera_rays += 1;
         match self.scene.intersect(ray) {
-            Some(hit) => self.li_hit(ray, &hit.sp, rng, c),
+            Some(hit) => self.li_hit_recorded(ray, &hit.sp, rng, c, rec),
             None => Rgb::ZERO,
         }
     }
@@ -99,18 +111,33 @@ impl Direct<'_> {
         rng: &mut impl Sampler,
         c: &mut Counts,
     ) -> Rgb {
+        self.li_hit_recorded(ray, sp, rng, c, &mut ())
+    }
+
+    /// `li_hit`, telling `rec` what the estimate is made of.
+    #[inline(always)]
+    fn li_hit_recorded(
+        &self,
+        ray: &Ray,
+        sp: &SurfacePoint,
+        rng: &mut impl Sampler,
+        c: &mut Counts,
+        rec: &mut impl Record,
+    ) -> Rgb {
         let scene = self.scene;
         let mut l = Rgb::ZERO;
         if !self.strategy.hide_emitters {
             if let Some((_, e)) = scene.emitter_at(sp) {
-                l += e.le(sp, -ray.d);
+                let le = e.le(sp, -ray.d);
+                rec.emitted(le);
+                l += le;
             }
         }
         let sh = self.shading(sp, ray.d);
         // A delta BSDF gives light samples zero throughput: all its light arrives via BSDF
         // samples, which then carry weight 1.
         let delta_bsdf = sh.mat.is_delta();
-        let mut one = One::new(self, &sh, rng, c, l);
+        let mut one = One::new(self, &sh, rng, c, rec, l);
         li(&mut one, delta_bsdf);
         one.l
     }

@@ -7,6 +7,7 @@
 use super::{Direct, Strategy, Weight};
 use crate::counts::Counts;
 use crate::integrator::direct::Shading;
+use crate::integrator::direct::Term;
 use crate::math::Rgb;
 use crate::sampler::Sampler;
 
@@ -35,29 +36,71 @@ pub(in crate::integrator) trait Techniques {
     fn split(&mut self, c: f32) -> (Self::Mask, Self::Mask);
 }
 
-/// The techniques at one hit, with `Direct`'s scalar code.
-pub(in crate::integrator) struct One<'r, 'd, 's, S> {
+/// What one camera sample's estimate is made of, for the images of `render --aov`: told
+/// each term as the estimate adds it. `()` records nothing (and compiles to nothing).
+pub trait Record {
+    /// The emission the camera ray sees.
+    fn emitted(&mut self, le: Rgb);
+    /// A sample of the light (`light`) or BSDF technique that carries light: its term as
+    /// added to the estimate, and its MIS weight (without one-sample MIS's division by the
+    /// technique's probability).
+    fn term(&mut self, light: bool, value: Rgb, mis_weight: f32);
+}
+
+impl Record for () {
+    #[inline(always)]
+    fn emitted(&mut self, _: Rgb) {}
+    #[inline(always)]
+    fn term(&mut self, _: bool, _: Rgb, _: f32) {}
+}
+
+/// The techniques at one hit, with `Direct`'s scalar code; `rec` is told every term.
+pub(in crate::integrator) struct One<'r, 'd, 's, S, R> {
     d: &'r Direct<'d>,
     sh: &'r Shading<'s>,
     rng: &'r mut S,
     c: &'r mut Counts,
+    rec: &'r mut R,
     /// The estimate so far.
     pub(in crate::integrator) l: Rgb,
 }
 
-impl<'r, 'd, 's, S: Sampler> One<'r, 'd, 's, S> {
+impl<'r, 'd, 's, S: Sampler, R: Record> One<'r, 'd, 's, S, R> {
     pub(in crate::integrator) fn new(
         d: &'r Direct<'d>,
         sh: &'r Shading<'s>,
         rng: &'r mut S,
         c: &'r mut Counts,
+        rec: &'r mut R,
         l: Rgb,
     ) -> Self {
-        One { d, sh, rng, c, l }
+        One {
+            d,
+            sh,
+            rng,
+            c,
+            rec,
+            l,
+        }
+    }
+
+    /// Adds a sample's term, weighted and divided by `n`, to the estimate.
+    #[inline(always)]
+    fn add(&mut self, light: bool, term: Option<Term>, weight: Weight, n: f32) {
+        let v = match term {
+            Some(t) => {
+                let (v, w) = t.weighted(weight);
+                let v = v / n;
+                self.rec.term(light, v, weight.mis_part(w));
+                v
+            }
+            None => Rgb::ZERO / n,
+        };
+        self.l += v;
     }
 }
 
-impl<S: Sampler> Techniques for One<'_, '_, '_, S> {
+impl<S: Sampler, R: Record> Techniques for One<'_, '_, '_, S, R> {
     type Mask = bool;
 
     #[inline(always)]
@@ -83,14 +126,18 @@ impl<S: Sampler> Techniques for One<'_, '_, '_, S> {
     #[inline(always)]
     fn light(&mut self, m: bool, weight: Weight, n: f32) {
         if m {
-            self.l += self.d.light_sample(self.sh, self.rng, weight, self.c) / n;
+            let drawn = self.d.light_draw(self.sh, self.rng, self.c);
+            let term = self.d.light_term(self.sh, drawn, self.c);
+            self.add(true, term, weight, n);
         }
     }
 
     #[inline(always)]
     fn bsdf(&mut self, m: bool, weight: Weight, n: f32) {
         if m {
-            self.l += self.d.bsdf_sample(self.sh, self.rng, weight, self.c) / n;
+            let drawn = self.d.bsdf_draw(self.sh, self.rng, self.c);
+            let term = self.d.bsdf_term(self.sh, drawn, self.c);
+            self.add(false, term, weight, n);
         }
     }
 
@@ -99,8 +146,10 @@ impl<S: Sampler> Techniques for One<'_, '_, '_, S> {
         let (d, sh) = (self.d, self.sh);
         let light = d.light_draw(sh, self.rng, self.c);
         let bsdf = d.bsdf_draw(sh, self.rng, self.c);
-        self.l += d.light_finish(sh, light, light_weight, self.c) / ne;
-        self.l += d.bsdf_finish(sh, bsdf, bsdf_weight, self.c) / nb;
+        let term = d.light_term(sh, light, self.c);
+        self.add(true, term, light_weight, ne);
+        let term = d.bsdf_term(sh, bsdf, self.c);
+        self.add(false, term, bsdf_weight, nb);
     }
 
     #[inline(always)]
