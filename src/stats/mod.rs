@@ -9,6 +9,7 @@ pub mod integrate_batched;
 pub mod nnls;
 pub mod ratio;
 pub mod slope;
+pub mod spectrum;
 pub mod ttest;
 pub mod welch_map;
 pub mod welford;

@@ -97,6 +97,38 @@ fn quick_fig4_crosses_samplers_and_reports_rates() {
         assert!(cells[2..5].iter().all(|c| c.contains("x [")), "{row}");
         assert!(cells[5] == "—" || cells[5].contains("x ["), "{row}");
     }
+    // Error spectra: one chart per strategy with a line per sampler, each bin with its
+    // interval, normalised so that the mean over all frequencies is 1 (it is a share of the
+    // MSE: the bins, unequal in size, average near 1).
+    let spectra = std::fs::read_to_string(dir.join("spectrum.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = spectra
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    for sampler in [
+        "independent",
+        "stratified",
+        "sobol",
+        "sobol-padded",
+        "sobol-xor",
+        "zsobol",
+    ] {
+        let ours: Vec<&Vec<&str>> = rows
+            .iter()
+            .filter(|r| r[0] == "mis-power-e1b1-uni-area" && r[1] == sampler)
+            .collect();
+        assert_eq!(ours.len(), 6, "12x12: six radial bins for {sampler}");
+        for r in ours {
+            let [p, lo, hi] = [5, 6, 7].map(|i| r[i].parse::<f64>().unwrap());
+            assert!(lo <= p && p <= hi && p > 0.0 && p < 10.0, "{r:?}");
+        }
+    }
+    assert!(dir.join("spectrum-bsdf-b1.png").is_file());
+    assert!(
+        index.contains("Error spectrum of MIS power per sampler at 4 spp"),
+        "{index}"
+    );
     std::fs::remove_dir_all(&out).unwrap();
 }
 

@@ -3,6 +3,7 @@
 
 mod charts;
 mod compare;
+mod spectrum;
 mod variance;
 
 pub use charts::charts;
@@ -65,5 +66,6 @@ pub fn images(o: &Outcome) -> Result<Vec<Figure>, String> {
         }
     }
     figs.extend(variance::variance_maps(o, o.exp.variance_spp())?);
+    figs.extend(spectrum::spectra(o)?);
     Ok(figs)
 }
