@@ -47,6 +47,9 @@ pub enum Command {
     /// Welch's t-test between two noisy renders (directories of seeds' EXRs, or EXRs with
     /// variances): a p-value map and a verdict, with no reference; exits non-zero on a bias.
     Compare(crate::compare::CompareArgs),
+    /// How small a bias `compare` finds: renders a configuration as two independent sides,
+    /// puts known biases into one, and tables the detection rate per spp and bias.
+    ComparePower(crate::compare::power::PowerArgs),
     /// Run Nori test files (`<test type="ttest">`, `<test type="chi2test">`): scenes against
     /// references per strategy, BSDF albedos, BSDF chi-square; exits non-zero on a failure.
     Test(crate::noritest::TestArgs),
@@ -208,6 +211,7 @@ pub fn main() -> i32 {
         }),
         Command::CheckSampler(a) => crate::checksampler::command(a),
         Command::Compare(a) => crate::compare::command(a),
+        Command::ComparePower(a) => crate::compare::power::command(a),
         Command::Extreme(a) => cmd_extreme(a),
         Command::Labels => {
             print!("{}", crate::labels::grammar());

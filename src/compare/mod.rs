@@ -8,6 +8,7 @@
 //! at `--alpha` over every test of the tile map (Sidak); a detected bias exits non-zero.
 
 mod page;
+pub mod power;
 mod sides;
 
 use crate::stats::welch_map::{Side, WelchMap};
@@ -110,17 +111,12 @@ pub fn run(a: &CompareArgs) -> Result<Verdict, String> {
     }
     let k = a.tile as usize;
     let pixels = WelchMap::new(&sa, &sb);
-    let tiles = WelchMap::new(&sa.tiled(k), &sb.tiled(k));
-    let level = tiles.level(a.alpha);
-    let mut regions = tiles.regions(level);
-    // Regions whose every tile has a side of all-equal seeds come last: alone they are no
-    // evidence (see `WelchMap::one_sided`).
-    regions.sort_by_key(|r| (r.one_sided, std::cmp::Reverse(r.units)));
-    let outcome = match regions.first() {
-        None => Outcome::Agree,
-        Some(r) if r.one_sided => Outcome::Inconclusive,
-        Some(_) => Outcome::Biased,
-    };
+    let Tested {
+        tiles,
+        level,
+        regions,
+        outcome,
+    } = test(&sa, &sb, k, a.alpha);
     std::fs::create_dir_all(&a.out).map_err(|e| format!("{}: {e}", a.out.display()))?;
     p_map_png(&a.out.join("p-pixels.png"), &pixels)?;
     p_map_png(&a.out.join("p-tiles.png"), &tiles)?;
@@ -206,6 +202,37 @@ pub fn run(a: &CompareArgs) -> Result<Verdict, String> {
         ),
     };
     Ok(Verdict { outcome, summary })
+}
+
+/// The tile map of two sides and its verdict.
+pub(crate) struct Tested {
+    pub tiles: WelchMap,
+    /// The per-test level (Sidak over every tile test).
+    pub level: f64,
+    /// Significant regions: those with a tile where both sides vary first, largest first.
+    pub regions: Vec<crate::stats::welch_map::Region>,
+    pub outcome: Outcome,
+}
+
+/// Welch's test of `a` against `b` over `k` x `k` tiles at family-wise `alpha`.
+pub(crate) fn test(a: &Side, b: &Side, k: usize, alpha: f64) -> Tested {
+    let tiles = WelchMap::new(&a.tiled(k), &b.tiled(k));
+    let level = tiles.level(alpha);
+    let mut regions = tiles.regions(level);
+    // Regions whose every tile has a side of all-equal seeds come last: alone they are no
+    // evidence (see `WelchMap::one_sided`).
+    regions.sort_by_key(|r| (r.one_sided, std::cmp::Reverse(r.units)));
+    let outcome = match regions.first() {
+        None => Outcome::Agree,
+        Some(r) if r.one_sided => Outcome::Inconclusive,
+        Some(_) => Outcome::Biased,
+    };
+    Tested {
+        tiles,
+        level,
+        regions,
+        outcome,
+    }
 }
 
 const INCONCLUSIVE: &str = "Every significant tile has a side whose seeds are \

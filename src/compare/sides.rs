@@ -89,6 +89,14 @@ pub(super) fn side(
     })
 }
 
+/// How the user gave the render line named `name`.
+fn flag(name: &str) -> String {
+    match name {
+        "power" | "power-run" => "the configuration".into(),
+        _ => format!("--render-{name}"),
+    }
+}
+
 /// Parses a side's render options, `directlab render`'s command line without the command
 /// (`scenes/cbox/cbox.xml --strategy light --spp 16`): split at white space, so no quoting.
 pub(super) fn render_line(line: &str, name: &str) -> Result<crate::render_cmd::RenderArgs, String> {
@@ -102,8 +110,15 @@ pub(super) fn render_line(line: &str, name: &str) -> Result<crate::render_cmd::R
     let parsed = <Line as clap::Parser>::try_parse_from(std::iter::once("render").chain(words))
         .map_err(|e| {
             let text = e.render().to_string();
-            let first = text.lines().next().unwrap_or("").trim_start_matches("error: ");
-            format!("--render-{name} {line:?}: {first} (expected a scene and `directlab render`'s options)")
+            let first = text
+                .lines()
+                .next()
+                .unwrap_or("")
+                .trim_start_matches("error: ");
+            format!(
+                "{} {line:?}: {first} (expected a scene and `directlab render`'s options)",
+                flag(name)
+            )
         })?;
     let a = parsed.args;
     for (given, opt) in [
@@ -112,11 +127,18 @@ pub(super) fn render_line(line: &str, name: &str) -> Result<crate::render_cmd::R
         (a.stats.is_some(), "--stats"),
         (a.seed.is_some(), "--seed"),
         (a.aov.is_some(), "--aov"),
+        (name == "power" && a.spp.is_some(), "--spp"),
     ] {
         if given {
             return Err(format!(
-                "--render-{name} {line:?}: {opt} is compare's to choose (it renders --seeds \
-                 seeds of each side into --out)"
+                "{} {line:?}: {opt} is compare's to choose (it renders --seeds seeds of each \
+                 side{})",
+                flag(name),
+                if name == "power" {
+                    " at each --spp"
+                } else {
+                    " into --out"
+                }
             ));
         }
     }
