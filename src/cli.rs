@@ -50,6 +50,9 @@ pub enum Command {
     /// How small a bias `compare` finds: renders a configuration as two independent sides,
     /// puts known biases into one, and tables the detection rate per spp and bias.
     ComparePower(crate::compare::power::PowerArgs),
+    /// The renderer's regression guard: every bundled scene against stored per-tile means
+    /// by the two-run test (`--store` rewrites them).
+    Guard(crate::compare::guard::GuardArgs),
     /// Run Nori test files (`<test type="ttest">`, `<test type="chi2test">`): scenes against
     /// references per strategy, BSDF albedos, BSDF chi-square; exits non-zero on a failure.
     Test(crate::noritest::TestArgs),
@@ -212,6 +215,7 @@ pub fn main() -> i32 {
         Command::CheckSampler(a) => crate::checksampler::command(a),
         Command::Compare(a) => crate::compare::command(a),
         Command::ComparePower(a) => crate::compare::power::command(a),
+        Command::Guard(a) => crate::compare::guard::command(a),
         Command::Extreme(a) => cmd_extreme(a),
         Command::Labels => {
             print!("{}", crate::labels::grammar());

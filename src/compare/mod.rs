@@ -7,6 +7,7 @@
 //! configuration (`--render-a`, `--render-b`) rendered here at `--seeds` seeds. The verdict is
 //! at `--alpha` over every test of the tile map (Sidak); a detected bias exits non-zero.
 
+pub mod guard;
 mod page;
 pub mod power;
 mod sides;
@@ -240,7 +241,7 @@ const INCONCLUSIVE: &str = "Every significant tile has a side whose seeds are \
     a real difference). Raise the spp or the seeds.";
 
 /// A region's A/B - 1, or what it is when B is 0 there.
-fn relative(r: f64) -> String {
+pub(crate) fn relative(r: f64) -> String {
     match r.is_nan() {
         true => "B is 0 there".into(),
         false => format!("A/B - 1 = {:+.3} %", 100.0 * r),

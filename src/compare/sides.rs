@@ -92,7 +92,7 @@ pub(super) fn side(
 /// How the user gave the render line named `name`.
 fn flag(name: &str) -> String {
     match name {
-        "power" | "power-run" => "the configuration".into(),
+        "power" | "power-run" | "guard" => "the configuration".into(),
         _ => format!("--render-{name}"),
     }
 }

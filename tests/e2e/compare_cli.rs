@@ -314,3 +314,47 @@ fn compare_power_tables_detection_rates() {
         "{text}"
     );
 }
+
+/// `directlab guard`: every bundled scene agrees with the stored tiles (this build renders
+/// what main rendered, within noise); stored tiles moved by 5 % in one scene make it fail
+/// and name that scene; a missing file is named with the command that writes it.
+#[test]
+fn guard_holds_the_bundled_scenes_and_names_a_moved_one() {
+    let dir = scratch("guard");
+    let tiles = repo("tests/regression/tiles.json");
+    let guard = |t: &Path| {
+        run_text(
+            directlab()
+                .arg("guard")
+                .arg("--tiles")
+                .arg(t)
+                .arg("--scenes")
+                .arg(repo("scenes")),
+        )
+    };
+    let (ok, text) = guard(&tiles);
+    assert!(ok && text.matches(": agrees (").count() == 8, "{text}");
+    let mut stored: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&tiles).unwrap()).unwrap();
+    for p in stored["cbox-plastic/cbox-plastic.xml"]["mean"]
+        .as_array_mut()
+        .unwrap()
+    {
+        for c in p.as_array_mut().unwrap() {
+            *c = serde_json::json!(c.as_f64().unwrap() * 1.05);
+        }
+    }
+    let moved = dir.join("moved.json");
+    std::fs::write(&moved, stored.to_string()).unwrap();
+    let (ok, text) = guard(&moved);
+    assert!(
+        !ok && text.contains("cbox-plastic/cbox-plastic.xml: MOVED")
+            && text.contains("1 of 8 bundled scenes differ"),
+        "{text}"
+    );
+    let (ok, text) = guard(&dir.join("none.json"));
+    assert!(
+        !ok && text.contains("directlab guard --store writes it"),
+        "{text}"
+    );
+}
