@@ -102,14 +102,8 @@ fn line(a: &GuardArgs, scene: &str, defines: &[(&str, &str)]) -> String {
 
 /// `SEEDS` renders of `line` from seed `first`, averaged over `TILE` x `TILE` tiles.
 pub(crate) fn render_tiles(line: &str, first: u64) -> Result<Side, String> {
-    let a = super::sides::render_line(line, "guard")?;
-    let mut images = Vec::new();
-    for i in 0..SEEDS {
-        let (out, _, _) = crate::render_cmd::render_args(&a, Some(first + i), false)?;
-        images.push(out.mean);
-    }
-    let (w, h) = (images[0].width as usize, images[0].height as usize);
-    let side = Side::from_seeds(w, h, images.into_iter().map(|i| i.data).collect());
+    let a = super::sides::render_line(line, "the guard's configuration", false)?;
+    let (side, _) = super::sides::render_seeds(&a, first, SEEDS, None)?;
     Ok(side.tiled(TILE))
 }
 

@@ -62,13 +62,14 @@ pub struct CompareArgs {
 }
 
 /// The two sides, and a line saying what each is.
-fn sides(a: &CompareArgs) -> Result<[(Side, String); 2], String> {
+fn load_sides(a: &CompareArgs) -> Result<[(Side, String); 2], String> {
     if let (Some(ra), Some(rb)) = (&a.render_a, &a.render_b) {
         // Both configurations are parsed before either renders.
-        let (pa, pb) = (sides::render_line(ra, "a")?, sides::render_line(rb, "b")?);
+        let pa = sides::render_line(ra, "--render-a", false)?;
+        let pb = sides::render_line(rb, "--render-b", false)?;
         let n = a.seeds;
-        let sa = sides::render_side(&pa, &a.out.join("a"), 0, n, "a")?;
-        let sb = sides::render_side(&pb, &a.out.join("b"), n, n, "b")?;
+        let sa = sides::render_seeds(&pa, 0, n, Some(&a.out.join("a")))?;
+        let sb = sides::render_seeds(&pb, n, n, Some(&a.out.join("b")))?;
         return Ok([sa, sb]);
     }
     let (Some(pa), Some(pb)) = (&a.a, &a.b) else {
@@ -103,7 +104,7 @@ pub fn run(a: &CompareArgs) -> Result<Verdict, String> {
     if !(a.alpha > 0.0 && a.alpha < 1.0) {
         return Err(format!("--alpha {}: expected a level in (0, 1)", a.alpha));
     }
-    let [(sa, name_a), (sb, name_b)] = sides(a)?;
+    let [(sa, name_a), (sb, name_b)] = load_sides(a)?;
     if (sa.width, sa.height) != (sb.width, sb.height) {
         return Err(format!(
             "{name_a} is {}x{} but {name_b} is {}x{}: compare renders of the same film",

@@ -4,6 +4,7 @@
 //! alarm rate. A table with Wilson 95 % intervals on every rate, and `power.csv`.
 
 use super::{sides, test, Outcome};
+use crate::render_cmd::RenderArgs;
 use crate::stats::welch_map::Side;
 use std::fmt::Write;
 use std::path::PathBuf;
@@ -14,7 +15,8 @@ pub struct PowerArgs {
     /// --spp ("scenes/cbox/cbox.xml -D res=64 --strategy mis").
     pub render: String,
     /// Samples per pixel of each seed's render (comma-separated).
-    #[arg(long, value_delimiter = ',', default_values_t = [16u32, 64, 256])]
+    #[arg(long, value_delimiter = ',', default_values_t = [16u32, 64, 256],
+          value_parser = crate::limits::parse_spp)]
     pub spp: Vec<u32>,
     /// Relative biases put into side B's region (comma-separated; 0 is always added, for the
     /// false alarm rate).
@@ -53,47 +55,39 @@ pub fn wilson(k: u64, n: u64) -> (f64, f64) {
     ((centre - half).max(0.0), (centre + half).min(1.0))
 }
 
-/// `seeds` renders of `line` at `spp`, seeds `first..`; or, `single`, one render of
+/// `seeds` renders of `a` at `spp`, seeds `first..`; or, `single`, one render of
 /// `seeds * spp` samples with its per-pixel variance.
-fn render_seeds(
-    line: &str,
+fn render_side(
+    a: &RenderArgs,
     spp: u32,
     first: u64,
     seeds: u64,
     single: bool,
 ) -> Result<Side, String> {
-    if single {
-        let n = spp as u64 * seeds;
-        let a = sides::render_line(&format!("{line} --spp {n}"), "power-run")?;
-        let (out, stats, _) = crate::render_cmd::render_args(&a, Some(first), false)?;
-        if stats.sampler != "independent" {
-            return Err(format!(
-                "--per-pixel-variance: the {} sampler's samples in a pixel are correlated, so \
-                 one render's variance is not the mean's; give seeds instead",
-                stats.sampler
-            ));
-        }
-        return Ok(Side {
-            width: out.mean.width as usize,
-            height: out.mean.height as usize,
-            mean: out.mean.data,
-            var_mean: out.variance.data,
-            n,
-            seeds: Vec::new(),
-        });
+    let mut a = a.clone();
+    if !single {
+        a.spp = Some(spp);
+        return Ok(sides::render_seeds(&a, first, seeds, None)?.0);
     }
-    let a = sides::render_line(&format!("{line} --spp {spp}"), "power-run")?;
-    let mut images = Vec::new();
-    for i in 0..seeds {
-        let (out, _, _) = crate::render_cmd::render_args(&a, Some(first + i), false)?;
-        images.push(out.mean);
+    let n = spp as u64 * seeds;
+    // Held to render's own bound on --spp.
+    a.spp = Some(crate::limits::parse_spp(&n.to_string())?);
+    let (out, stats, _) = crate::render_cmd::render_args(&a, Some(first), false)?;
+    if stats.sampler != "independent" {
+        return Err(format!(
+            "--per-pixel-variance: the {} sampler's samples in a pixel are correlated, so \
+             one render's variance is not the mean's; give seeds instead",
+            stats.sampler
+        ));
     }
-    let (w, h) = (images[0].width as usize, images[0].height as usize);
-    Ok(Side::from_seeds(
-        w,
-        h,
-        images.into_iter().map(|i| i.data).collect(),
-    ))
+    Ok(Side {
+        width: out.mean.width as usize,
+        height: out.mean.height as usize,
+        mean: out.mean.data,
+        var_mean: out.variance.data,
+        n,
+        seeds: Vec::new(),
+    })
 }
 
 /// `s` with its pixels in the centred square of side `frac` scaled by `1 + b` (each seed's,
@@ -141,8 +135,8 @@ pub fn command(a: &PowerArgs) -> Result<(), String> {
     if let Some(b) = a.bias.iter().find(|b| !(b.is_finite() && **b > -1.0)) {
         return Err(format!("--bias {b}: expected a relative bias above -1"));
     }
-    // Checked once, before any render (it may not set --spp: that is ours).
-    sides::render_line(&a.render, "power")?;
+    // Parsed once, before any render (it may not set --spp: that is ours).
+    let config = sides::render_line(&a.render, "the configuration", true)?;
     let mut biases = vec![0.0];
     biases.extend(a.bias.iter().copied().filter(|b| *b != 0.0));
     let k = a.tile as usize;
@@ -161,8 +155,8 @@ pub fn command(a: &PowerArgs) -> Result<(), String> {
             // Every render of the whole command has its own seeds.
             let first = ((si as u64 * a.trials + t) * 2) * a.seeds;
             let single = a.per_pixel_variance;
-            let sa = render_seeds(&a.render, spp, first, a.seeds, single)?;
-            let sb = render_seeds(&a.render, spp, first + a.seeds, a.seeds, single)?;
+            let sa = render_side(&config, spp, first, a.seeds, single)?;
+            let sb = render_side(&config, spp, first + a.seeds, a.seeds, single)?;
             for (d, &b) in detected.iter_mut().zip(&biases) {
                 match test(&sa, &biased(&sb, b, a.region), k, a.alpha).outcome {
                     Outcome::Biased => d.0 += 1,

@@ -2,6 +2,7 @@
 //! rendered here from two configurations.
 
 use crate::film::read_exr;
+use crate::render_cmd::RenderArgs;
 use crate::stats::welch_map::Side;
 use std::path::{Path, PathBuf};
 
@@ -89,36 +90,24 @@ pub(super) fn side(
     })
 }
 
-/// How the user gave the render line named `name`.
-fn flag(name: &str) -> String {
-    match name {
-        "power" | "power-run" | "guard" => "the configuration".into(),
-        _ => format!("--render-{name}"),
-    }
-}
-
 /// Parses a side's render options, `directlab render`'s command line without the command
-/// (`scenes/cbox/cbox.xml --strategy light --spp 16`): split at white space, so no quoting.
-pub(super) fn render_line(line: &str, name: &str) -> Result<crate::render_cmd::RenderArgs, String> {
+/// (`scenes/cbox/cbox.xml --strategy light --spp 16`), split at white space (no quoting).
+/// `flag` says how the user gave it; the seed and the outputs are the caller's to choose,
+/// and so is the spp where `spp_ours`.
+pub(super) fn render_line(line: &str, flag: &str, spp_ours: bool) -> Result<RenderArgs, String> {
     #[derive(clap::Parser)]
     #[command(name = "render")]
     struct Line {
         #[command(flatten)]
-        args: crate::render_cmd::RenderArgs,
+        args: RenderArgs,
     }
-    let words: Vec<&str> = line.split_whitespace().collect();
+    let words = line.split_whitespace();
     let parsed = <Line as clap::Parser>::try_parse_from(std::iter::once("render").chain(words))
         .map_err(|e| {
             let text = e.render().to_string();
-            let first = text
-                .lines()
-                .next()
-                .unwrap_or("")
-                .trim_start_matches("error: ");
-            format!(
-                "{} {line:?}: {first} (expected a scene and `directlab render`'s options)",
-                flag(name)
-            )
+            let first = text.lines().next().unwrap_or("");
+            let first = first.trim_start_matches("error: ");
+            format!("{flag} {line:?}: {first} (expected a scene and `directlab render`'s options)")
         })?;
     let a = parsed.args;
     for (given, opt) in [
@@ -127,60 +116,58 @@ pub(super) fn render_line(line: &str, name: &str) -> Result<crate::render_cmd::R
         (a.stats.is_some(), "--stats"),
         (a.seed.is_some(), "--seed"),
         (a.aov.is_some(), "--aov"),
-        (name == "power" && a.spp.is_some(), "--spp"),
+        (spp_ours && a.spp.is_some(), "--spp"),
     ] {
         if given {
             return Err(format!(
-                "{} {line:?}: {opt} is compare's to choose (it renders --seeds seeds of each \
-                 side{})",
-                flag(name),
-                if name == "power" {
-                    " at each --spp"
-                } else {
-                    " into --out"
-                }
+                "{flag} {line:?}: {opt} is compare's to choose (it renders the seeds{} and \
+                 writes the outputs itself)",
+                if spp_ours { " at each spp" } else { "" }
             ));
         }
     }
     Ok(a)
 }
 
-/// Renders `seeds` seeds of one side into `dir` (`seed-000.exr`, ...), seeds `first..`; a
-/// side's seeds differ from the other side's, so the two are independent even when the
-/// configurations are equal. Returns the side and a line on what ran.
-pub(super) fn render_side(
-    a: &crate::render_cmd::RenderArgs,
-    dir: &Path,
+/// Renders `seeds` seeds of `a`, seeds `first..`, as one side; with `dir`, also writes them
+/// there (`seed-000.exr`, ..., after removing an earlier run's). A non-finite sample is an
+/// error: such a render is not an estimate to test. Returns the side and a line on what ran.
+pub(super) fn render_seeds(
+    a: &RenderArgs,
     first: u64,
     seeds: u64,
-    name: &str,
+    dir: Option<&Path>,
 ) -> Result<(Side, String), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    // Seeds of an earlier, longer run would join this one's: remove them.
-    for e in std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))? {
-        let p = e.map_err(|e| format!("{}: {e}", dir.display()))?.path();
-        let ours = p
-            .file_name()
-            .and_then(|n| n.to_str())
-            .is_some_and(|n| n.starts_with("seed-") && n.ends_with(".exr"));
-        if ours {
-            std::fs::remove_file(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+    if let Some(dir) = dir {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        // Seeds of an earlier, longer run would join this one's: remove them.
+        for e in std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))? {
+            let p = e.map_err(|e| format!("{}: {e}", dir.display()))?.path();
+            let ours = p
+                .file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("seed-") && n.ends_with(".exr"));
+            if ours {
+                std::fs::remove_file(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+            }
         }
     }
     let mut images = Vec::new();
     let mut seconds = 0.0;
     let mut line = String::new();
     for i in 0..seeds {
-        let (out, stats, _) = crate::render_cmd::render_args(a, Some(first + i), false)?;
+        let seed = first + i;
+        let (out, stats, _) = crate::render_cmd::render_args(a, Some(seed), false)?;
         if out.non_finite_samples > 0 {
             return Err(format!(
-                "side {name}, seed {}: {} non-finite samples: the render is not an estimate \
-                 to test",
-                first + i,
+                "{}, seed {seed}: {} non-finite samples: the render is not an estimate to test",
+                a.scene.display(),
                 out.non_finite_samples
             ));
         }
-        crate::film::write_exr(&dir.join(format!("seed-{i:03}.exr")), &out.mean)?;
+        if let Some(dir) = dir {
+            crate::film::write_exr(&dir.join(format!("seed-{i:03}.exr")), &out.mean)?;
+        }
         seconds += stats.seconds;
         if i == 0 {
             line = format!(
@@ -192,11 +179,9 @@ pub(super) fn render_side(
     }
     let (w, h) = (images[0].width as usize, images[0].height as usize);
     let side = Side::from_seeds(w, h, images.into_iter().map(|i| i.data).collect());
+    let last = first + seeds - 1;
     Ok((
         side,
-        format!(
-            "{line}; seeds {first}..{} in {seconds:.2} s",
-            first + seeds - 1
-        ),
+        format!("{line}; seeds {first}..{last} in {seconds:.2} s"),
     ))
 }

@@ -94,7 +94,7 @@ impl<'r, 'd, 's, S: Sampler, R: Record> One<'r, 'd, 's, S, R> {
                 self.rec.term(light, v, weight.mis_part(w));
                 v
             }
-            None => Rgb::ZERO / n,
+            None => Rgb::ZERO,
         };
         self.l += v;
     }
