@@ -202,6 +202,13 @@ fn cmd_reproduce(a: &ReproduceArgs) -> Result<(), String> {
 /// Runs the CLI; returns the process exit code.
 pub fn main() -> i32 {
     let cli = Cli::parse();
+    if let Some(bug) = directlab_render::seeded::current() {
+        // A test build (`seeded-bugs`) with DIRECTLAB_SEEDED_BUG set: never silently.
+        eprintln!(
+            "warning: seeded bug '{}' is active ({bug:?}): this run's images are wrong on purpose",
+            directlab_render::seeded::tag()
+        );
+    }
     let r = match &cli.command {
         Command::Render(a) => crate::render_cmd::command(a),
         Command::Run(a) => cmd_run(a),

@@ -21,6 +21,7 @@ mod quick_figures;
 mod readme;
 mod reference_cache;
 mod render_cli;
+mod seeded_bugs;
 mod shard_cli;
 mod shard_damage;
 mod slurm_e2e;

@@ -69,6 +69,7 @@ pub mod rng;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod seeded;
 
 /// Hash of this crate's source files and of the resolved versions of the crates it depends
 /// on (from `Cargo.lock`), computed by `build.rs`: two builds with the same hash render the

@@ -362,6 +362,10 @@ pub fn markdown(t: &Table) -> String {
           rendered; mistakes that leave every sampler consistent but combine them wrongly \
           (MIS weights from different directions) only show as bias, against a closed form \
           or between strategies. A back-facing light given a pdf biases no estimate here \
-          (its radiance is 0 from behind) and only chi-square sees it.\n";
+          (its radiance is 0 from behind) and only chi-square sees it.\n\n\
+          Bugs seeded into the renderer itself, each wrong in one corner of the configuration \
+          space (one side of a surface, one range of angles, one kind of shape, one \
+          material), are found by the two-run test against the correct build with no \
+          reference: [seeded-bugs/index.md](seeded-bugs/index.md), with their p-value maps.\n";
     s
 }

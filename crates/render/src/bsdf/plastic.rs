@@ -78,7 +78,11 @@ impl Plastic {
     /// The diffuse lobe's f |cos_o| given F(cos_i).
     #[inline]
     fn diffuse(&self, f_i: f32, wo: Vec3) -> Rgb {
-        let f_o = fresnel_dielectric(wo.z, self.eta).0;
+        let f_o = if crate::seeded::active(crate::seeded::SeededBug::PlasticExitFresnel) {
+            f_i
+        } else {
+            fresnel_dielectric(wo.z, self.eta).0
+        };
         self.diffuse_scale * ((1.0 - f_i) * (1.0 - f_o) * INV_PI * wo.z)
     }
 }

@@ -39,14 +39,23 @@ fn facing(ref_p: Vec3, sp: &SurfacePoint) -> Option<(Vec3, f32)> {
     }
     let inv = dist.recip();
     let wi = Vec3::new(d.x * inv, d.y * inv, d.z * inv);
-    (sp.ns.dot(-wi) > 0.0).then_some((wi, dist))
+    let cos = sp.ns.dot(-wi);
+    let faces = if crate::seeded::active(crate::seeded::SeededBug::BackFacingLight) {
+        cos != 0.0
+    } else {
+        cos > 0.0
+    };
+    faces.then_some((wi, dist))
 }
 
 /// Uniform-by-area density, in solid angle, of a light point of a light of area `area` that
 /// faces the reference point along `wi` at distance `dist`.
 #[inline]
 pub(crate) fn area_pdf_along(area: f32, sp: &SurfacePoint, wi: Vec3, dist: f32) -> f32 {
-    let cos_l = sp.ng.dot(wi).abs();
+    let mut cos_l = sp.ng.dot(wi).abs();
+    if crate::seeded::active(crate::seeded::SeededBug::GrazingCosClamp) {
+        cos_l = cos_l.max(0.1);
+    }
     if cos_l > 0.0 {
         dist * dist / (area * cos_l)
     } else {
@@ -81,6 +90,12 @@ pub(crate) fn sample_at(
 /// `AreaLight::sample` and the lane kernel, so both make the same point).
 #[inline]
 pub(crate) fn sphere_area_point(s: &Sphere, u: Vec2, shape: u32) -> SurfacePoint {
+    if crate::seeded::active(crate::seeded::SeededBug::SpherePolarUniform) {
+        let (sin, cos) = (std::f32::consts::PI * u.x).sin_cos();
+        let phi = std::f32::consts::TAU * u.y;
+        let d = Vec3::new(sin * phi.cos(), sin * phi.sin(), cos);
+        return s.surface_point_along(d, shape);
+    }
     s.surface_point_along(square_to_uniform_sphere(u), shape)
 }
 
