@@ -19,9 +19,9 @@ use std::path::PathBuf;
 
 #[derive(clap::Args, Debug)]
 pub struct CompareArgs {
-    /// Side A: a directory of EXRs (one per seed), or one EXR with --variance-a and --spp-a
-    /// (a render of independent samples only: for stratified, Sobol' or zsobol renders,
-    /// whose pixels' samples are correlated, give seeds).
+    /// Side A: a directory of EXRs (one per seed), or one EXR with --variance-a and its spp
+    /// (--stats-a or --spp-a; a render of independent samples only: for stratified, Sobol'
+    /// or zsobol renders, whose pixels' samples are correlated, give seeds).
     #[arg(required_unless_present = "render_a", conflicts_with = "render_a")]
     pub a: Option<PathBuf>,
     /// Side B, as A.
@@ -29,10 +29,12 @@ pub struct CompareArgs {
     pub b: Option<PathBuf>,
     /// Render side A here: a scene and `directlab render`'s options, as one string
     /// ("scenes/cbox/cbox.xml --strategy light --spp 16"), at --seeds seeds.
-    #[arg(long, requires = "render_b")]
+    /// Either side may be files and the other rendered (another renderer's seeds against
+    /// directlab's).
+    #[arg(long)]
     pub render_a: Option<String>,
     /// Render side B here, as --render-a (with other seeds than A's).
-    #[arg(long, requires = "render_a")]
+    #[arg(long)]
     pub render_b: Option<String>,
     /// Seeds per side rendered with --render-a/-b (the samples of the test).
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u64).range(2..=10000))]
@@ -43,7 +45,15 @@ pub struct CompareArgs {
     /// The variance-of-the-mean EXR of a single render B.
     #[arg(long)]
     pub variance_b: Option<PathBuf>,
-    /// Samples per pixel of a single render A.
+    /// `render --stats` of a single render A: its spp and its sampler, which must be the
+    /// independent one (a correlated sampler's per-pixel variance is refused).
+    #[arg(long)]
+    pub stats_a: Option<PathBuf>,
+    /// `render --stats` of a single render B.
+    #[arg(long)]
+    pub stats_b: Option<PathBuf>,
+    /// Samples per pixel of a single render A (without --stats-a: its sampler is then taken
+    /// on trust to be independent).
     #[arg(long)]
     pub spp_a: Option<u64>,
     /// Samples per pixel of a single render B.
@@ -63,24 +73,42 @@ pub struct CompareArgs {
 
 /// The two sides, and a line saying what each is.
 fn load_sides(a: &CompareArgs) -> Result<[(Side, String); 2], String> {
-    if let (Some(ra), Some(rb)) = (&a.render_a, &a.render_b) {
-        // Both configurations are parsed before either renders.
-        let pa = sides::render_line(ra, "--render-a", false)?;
-        let pb = sides::render_line(rb, "--render-b", false)?;
-        let n = a.seeds;
-        let sa = sides::render_seeds(&pa, 0, n, Some(&a.out.join("a")))?;
-        let sb = sides::render_seeds(&pb, n, n, Some(&a.out.join("b")))?;
-        return Ok([sa, sb]);
-    }
-    let (Some(pa), Some(pb)) = (&a.a, &a.b) else {
-        return Err("give sides A and B, or --render-a and --render-b".into());
+    // Both configurations are parsed, and the file sides read, before anything renders.
+    let line = |l: &Option<String>, flag| {
+        l.as_deref()
+            .map(|l| sides::render_line(l, flag, false))
+            .transpose()
     };
-    let sa = sides::side(pa, a.variance_a.as_deref(), a.spp_a, "a")?;
-    let sb = sides::side(pb, a.variance_b.as_deref(), a.spp_b, "b")?;
-    Ok([
-        (sa, pa.display().to_string()),
-        (sb, pb.display().to_string()),
-    ])
+    let (ra, rb) = (
+        line(&a.render_a, "--render-a")?,
+        line(&a.render_b, "--render-b")?,
+    );
+    let file = |p: &Option<PathBuf>, spec: sides::Single, name: &str| match p {
+        Some(p) => sides::side(p, spec, name).map(|s| Some((s, p.display().to_string()))),
+        None => Ok(None),
+    };
+    let fa = file(
+        &a.a,
+        sides::Single::of(&a.variance_a, &a.stats_a, a.spp_a),
+        "a",
+    )?;
+    let fb = file(
+        &a.b,
+        sides::Single::of(&a.variance_b, &a.stats_b, a.spp_b),
+        "b",
+    )?;
+    let n = a.seeds;
+    let sa = match (fa, &ra) {
+        (Some(s), _) => s,
+        (None, Some(r)) => sides::render_seeds(r, 0, n, Some(&a.out.join("a")))?,
+        (None, None) => return Err("give side A (files) or --render-a".into()),
+    };
+    let sb = match (fb, &rb) {
+        (Some(s), _) => s,
+        (None, Some(r)) => sides::render_seeds(r, n, n, Some(&a.out.join("b")))?,
+        (None, None) => return Err("give side B (files) or --render-b".into()),
+    };
+    Ok([sa, sb])
 }
 
 /// What a comparison found.

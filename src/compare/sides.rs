@@ -7,17 +7,76 @@ use crate::stats::welch_map::Side;
 use std::path::{Path, PathBuf};
 
 /// Loads one side.
-pub(super) fn side(
-    path: &Path,
-    variance: Option<&Path>,
-    spp: Option<u64>,
-    name: &str,
-) -> Result<Side, String> {
+/// What a single render's side comes with: its variance image, and its spp from `render
+/// --stats` (which also names its sampler) or given by hand.
+pub(super) struct Single<'a> {
+    pub variance: Option<&'a Path>,
+    pub stats: Option<&'a Path>,
+    pub spp: Option<u64>,
+}
+
+impl<'a> Single<'a> {
+    pub fn of(variance: &'a Option<PathBuf>, stats: &'a Option<PathBuf>, spp: Option<u64>) -> Self {
+        Single {
+            variance: variance.as_deref(),
+            stats: stats.as_deref(),
+            spp,
+        }
+    }
+}
+
+/// The spp of a single render from its `render --stats`, refusing a correlated sampler.
+fn stats_spp(stats: &Path, spp: Option<u64>, name: &str) -> Result<u64, String> {
+    let text = std::fs::read_to_string(stats).map_err(|e| format!("{}: {e}", stats.display()))?;
+    let v: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| format!("{}: not `render --stats` JSON: {e}", stats.display()))?;
+    let (Some(sampler), Some(n)) = (v["sampler"].as_str(), v["spp"].as_u64()) else {
+        return Err(format!(
+            "{}: expected `render --stats` JSON with 'sampler' and 'spp'",
+            stats.display()
+        ));
+    };
+    if sampler != "independent" {
+        return Err(format!(
+            "{}: side {name} was rendered with the {sampler} sampler, whose samples in a pixel \
+             are correlated: its per-pixel variance is not the variance of its mean. Compare \
+             seeds instead (a directory of one EXR per seed, or --render-{name})",
+            stats.display()
+        ));
+    }
+    match spp {
+        Some(s) if s != n => Err(format!(
+            "--spp-{name} {s}, but {} says {n}",
+            stats.display()
+        )),
+        _ => Ok(n),
+    }
+}
+
+pub(super) fn side(path: &Path, single: Single, name: &str) -> Result<Side, String> {
+    let Single {
+        variance,
+        stats,
+        spp,
+    } = single;
+    if !path.exists() {
+        return Err(format!(
+            "{}: no such file or directory (side {name}: a directory of seeds' EXRs, or one EXR)",
+            path.display()
+        ));
+    }
     if path.is_dir() {
         let mut files: Vec<PathBuf> = std::fs::read_dir(path)
             .map_err(|e| format!("{}: {e}", path.display()))?
             .filter_map(|e| e.ok().map(|e| e.path()))
             .filter(|p| p.extension().is_some_and(|x| x.eq_ignore_ascii_case("exr")))
+            // Hidden files are writers' temporaries (experiments/mitsuba_compare.py).
+            .filter(|p| {
+                !p.file_name()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .starts_with('.')
+            })
             .collect();
         files.sort();
         if files.len() < 2 {
@@ -48,10 +107,14 @@ pub(super) fn side(
         let seeds = images.into_iter().map(|i| i.data).collect();
         return Ok(Side::from_seeds(w as usize, h as usize, seeds));
     }
+    let spp = match stats {
+        Some(st) => Some(stats_spp(st, spp, name)?),
+        None => spp,
+    };
     let (Some(var), Some(n)) = (variance, spp) else {
         return Err(format!(
-            "{}: a single render as side {name} needs --variance-{name} and --spp-{name} \
-             (or give a directory of seeds' EXRs)",
+            "{}: a single render as side {name} needs --variance-{name} and --stats-{name} \
+             (or --spp-{name}); or give a directory of seeds' EXRs",
             path.display()
         ));
     };

@@ -106,9 +106,59 @@ fn single_renders_with_variances_agree_and_bad_input_is_named() {
     // No variance for a single render; one seed in a directory; different sizes.
     let (ok, text) = compare(&[a.as_os_str(), b.as_os_str()]);
     assert!(
-        !ok && text.contains("needs --variance-a and --spp-a"),
+        !ok && text.contains("needs --variance-a and --stats-a (or --spp-a)"),
         "{text}"
     );
+    // `render --stats` gives a single render's spp and sampler: an independent one is
+    // taken, a correlated one (sobol) refused by name.
+    for (sampler, name) in [("independent", "i"), ("sobol", "s")] {
+        let (img, var, st) = (
+            dir.join(format!("{name}.exr")),
+            dir.join(format!("{name}-var.exr")),
+            dir.join(format!("{name}.json")),
+        );
+        let o = run(directlab()
+            .arg("render")
+            .arg(repo("scenes/cbox/cbox.xml"))
+            .args([
+                "-D",
+                "res=64",
+                "--spp",
+                "64",
+                "--seed",
+                "5",
+                "--sampler",
+                sampler,
+            ])
+            .arg("--out")
+            .arg(&img)
+            .arg("--variance")
+            .arg(&var)
+            .arg("--stats")
+            .arg(&st));
+        assert!(o.status.success());
+        let mut args: Vec<&std::ffi::OsStr> = vec![img.as_os_str(), b.as_os_str()];
+        args.extend([
+            "--variance-a".as_ref(),
+            var.as_os_str(),
+            "--stats-a".as_ref(),
+        ]);
+        args.extend([st.as_os_str(), "--variance-b".as_ref(), bv.as_os_str()]);
+        args.extend([
+            "--spp-b".as_ref(),
+            "64".as_ref(),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ]);
+        let (ok, text) = compare(&args);
+        match sampler {
+            "independent" => assert!(ok && text.contains("no bias detected"), "{text}"),
+            _ => assert!(
+                !ok && text.contains("sobol sampler") && text.contains("correlated"),
+                "{text}"
+            ),
+        }
+    }
     let one = dir.join("one");
     std::fs::create_dir_all(&one).unwrap();
     std::fs::copy(&a, one.join("s.exr")).unwrap();

@@ -16,6 +16,7 @@ mod extreme;
 mod html_page;
 mod integrands_cli;
 mod layout;
+mod mitsuba_cli;
 mod noritest_cli;
 mod quick_figures;
 mod readme;
