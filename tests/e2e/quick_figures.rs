@@ -29,6 +29,15 @@ fn quick_fig3_reads_a_tiny_light_as_a_tail_not_a_bias() {
         .collect();
     assert!(!between.is_empty(), "{stdout}");
     assert!(between.iter().all(|p| p.contains("consistent")), "{stdout}");
+    // The per-technique images at the comparison spp, one row per strategy.
+    let dir = out.join("fig3-quick");
+    let png = image::open(dir.join("techniques.png")).unwrap();
+    assert!(png.height() > 4 * 100, "{}x{}", png.width(), png.height());
+    let index = std::fs::read_to_string(dir.join("index.md")).unwrap();
+    assert!(
+        index.contains("![techniques.png](techniques.png)"),
+        "{index}"
+    );
     std::fs::remove_dir_all(&out).unwrap();
 }
 

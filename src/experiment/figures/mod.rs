@@ -4,6 +4,7 @@
 mod charts;
 mod compare;
 mod spectrum;
+mod techniques;
 mod variance;
 
 pub use charts::charts;
@@ -67,5 +68,6 @@ pub fn images(o: &Outcome) -> Result<Vec<Figure>, String> {
     }
     figs.extend(variance::variance_maps(o, o.exp.variance_spp())?);
     figs.extend(spectrum::spectra(o)?);
+    figs.extend(techniques::techniques(o)?);
     Ok(figs)
 }
