@@ -21,8 +21,8 @@ pub enum Command {
     Render(crate::render_cmd::RenderArgs),
     /// Run experiments (sweeps against a cached reference) and write their reports.
     Run(RunArgs),
-    /// Run the study's figures and this project's: fig1, fig2, fig3, fig4, fig4-veach, fig5,
-    /// fig5-cbox, fig5-tiles and the integrands report.
+    /// Run the study's figures and this project's: fig1, fig2, fig3, fig4, fig4-veach,
+    /// fig4-blue, fig5, fig5-cbox, fig5-tiles and the integrands report.
     Reproduce(ReproduceArgs),
     /// Split an experiment into fixed units (reference chunks, sweep runs, equal-time runs)
     /// for `run --shard I/N`; writes <out>/<name>/plan.json.
@@ -170,6 +170,7 @@ pub const REPRODUCE: &[&str] = &[
     "fig3",
     "fig4",
     "fig4-veach",
+    "fig4-blue",
     "fig5",
     "fig5-cbox",
     "fig5-tiles",

@@ -27,7 +27,8 @@ pub(super) fn techniques(o: &Outcome) -> Result<Option<Figure>, String> {
         return Ok(None);
     }
     let spp = o.exp.equal_spp();
-    let scene = directlab_render::scene::open(o.exp.scene(), o.exp.defines())?;
+    let case = &o.exp.cases[0];
+    let scene = directlab_render::scene::open_with(&case.scene, &case.defines, case.integrator)?;
     let exposure = o.exp.exp.figures.exposure.unwrap_or(1.0);
     let mut rows = Vec::new();
     for ((_, name), method) in o.strategies.iter().zip(&o.methods) {
