@@ -231,6 +231,15 @@ pub fn run(a: &CompareArgs) -> Result<Verdict, String> {
             page.display()
         ),
     };
+    // Non-finite input is excluded, never tested, and said so beside the verdict too.
+    let summary = match pixels.excluded() {
+        0 => summary,
+        n => format!(
+            "{summary}\nexcluded: {n} pixel(s) with non-finite input ({} tile(s) not tested; \
+             mapped in red on the page)",
+            tiles.excluded()
+        ),
+    };
     Ok(Verdict { outcome, summary })
 }
 

@@ -1,7 +1,6 @@
 //! The two sides of a comparison: read from seeds' EXRs or a render with its variance, or
 //! rendered here from two configurations.
 
-use crate::film::read_exr;
 use crate::render_cmd::RenderArgs;
 use crate::stats::welch_map::Side;
 use std::path::{Path, PathBuf};
@@ -51,6 +50,14 @@ fn stats_spp(stats: &Path, spp: Option<u64>, name: &str) -> Result<u64, String> 
         )),
         _ => Ok(n),
     }
+}
+
+/// An RGB(A) EXR, with what was expected when it has other channels.
+fn read_exr(path: &Path) -> Result<crate::film::Image, String> {
+    crate::film::read_exr(path).map_err(|e| match e.contains("no layer") {
+        true => format!("{e}: expected R, G and B channels (an RGB or RGBA image)"),
+        false => e,
+    })
 }
 
 pub(super) fn side(path: &Path, single: Single, name: &str) -> Result<Side, String> {

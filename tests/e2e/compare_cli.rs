@@ -66,6 +66,27 @@ fn seeds_agree_and_a_three_percent_light_is_detected() {
         "{text}"
     );
     assert!(out.join("index.html").exists() && out.join("p-tiles.png").exists());
+    // A NaN pixel in one seed is excluded, said so, and mapped; the rest still agrees.
+    let nan = dir.join("nan");
+    std::fs::create_dir_all(&nan).unwrap();
+    for f in std::fs::read_dir(&a).unwrap() {
+        let f = f.unwrap().path();
+        std::fs::copy(&f, nan.join(f.file_name().unwrap())).unwrap();
+    }
+    let one = nan.join("seed0.exr");
+    let mut img = read_exr(&one).unwrap();
+    img.data[64 * 5 + 3][1] = f64::NAN;
+    write_exr(&one, &img).unwrap();
+    let (ok, text) = compare(&[
+        nan.as_os_str(),
+        b.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert!(
+        ok && text.contains("excluded: 1 pixel(s) with non-finite input (1 tile(s) not tested"),
+        "{text}"
+    );
     let (ok, text) = compare(&[
         a.as_os_str(),
         b3.as_os_str(),
