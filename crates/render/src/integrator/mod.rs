@@ -4,6 +4,7 @@
 
 mod direct;
 mod lanes;
+pub mod optimal;
 mod strategies;
 mod strategy;
 
