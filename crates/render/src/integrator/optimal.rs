@@ -49,10 +49,10 @@ impl Sums {
         self.a[0] += p[0] * p[0] * inv2;
         self.a[1] += p[0] * p[1] * inv2;
         self.a[2] += p[1] * p[1] * inv2;
-        for c in 0..3 {
-            self.b[0][c] += f[c] * p[0] * inv2;
-            self.b[1][c] += f[c] * p[1] * inv2;
-            self.sf[c] += f[c] * inv;
+        for (c, &fc) in f.iter().enumerate() {
+            self.b[0][c] += fc * p[0] * inv2;
+            self.b[1][c] += fc * p[1] * inv2;
+            self.sf[c] += fc * inv;
         }
         self.sp[0] += p[0] * inv;
         self.sp[1] += p[1] * inv;
