@@ -20,6 +20,14 @@ pub fn scratch(name: &str) -> PathBuf {
     d
 }
 
+/// Writes a generated report's `index.md` into `dir` (a temporary file, renamed).
+pub fn write_index(dir: &Path, md: &str) {
+    std::fs::create_dir_all(dir).unwrap();
+    let tmp = dir.join("index.md.tmp");
+    std::fs::write(&tmp, md).unwrap();
+    std::fs::rename(&tmp, dir.join("index.md")).unwrap();
+}
+
 /// The `directlab` command built for these tests.
 pub fn directlab() -> Command {
     Command::new(env!("CARGO_BIN_EXE_directlab"))

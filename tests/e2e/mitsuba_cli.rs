@@ -7,7 +7,7 @@
 //! tests say they are skipped, unless DIRECTLAB_REQUIRE_MITSUBA is set (then they fail).
 //! `mitsuba_report` (ignored) regenerates `reports/mitsuba-compare/`.
 
-use crate::common::{directlab, repo, run_text, scratch};
+use crate::common::{directlab, repo, run_text, scratch, write_index};
 use std::fmt::Write;
 use std::path::Path;
 use std::process::Command;
@@ -146,9 +146,6 @@ fn mitsuba_report() {
             .unwrap();
         }
     }
-    std::fs::create_dir_all(&out).unwrap();
-    let tmp = out.join("index.md.tmp");
-    std::fs::write(&tmp, md).unwrap();
-    std::fs::rename(&tmp, out.join("index.md")).unwrap();
+    write_index(&out, &md);
     let _ = std::fs::remove_dir_all(&work);
 }

@@ -9,7 +9,7 @@
 //! `reports/seeded-bugs/` (`cargo test --release seeded_bug_gallery_report -- --ignored`),
 //! with each case's p-value maps at 16 and 64 spp.
 
-use crate::common::{directlab, repo, run_text, scratch};
+use crate::common::{directlab, repo, run_text, scratch, write_index};
 use directlab_render::seeded::{self, SeededBug};
 use std::fmt::Write;
 use std::path::Path;
@@ -197,9 +197,6 @@ fn seeded_bug_gallery_report() {
             .unwrap();
         }
     }
-    std::fs::create_dir_all(&out).unwrap();
-    let tmp = out.join("index.md.tmp");
-    std::fs::write(&tmp, md).unwrap();
-    std::fs::rename(&tmp, out.join("index.md")).unwrap();
+    write_index(&out, &md);
     let _ = std::fs::remove_dir_all(&work);
 }
