@@ -5,6 +5,7 @@ pub(crate) mod elementary;
 pub(crate) mod erf;
 pub mod gauss_legendre;
 pub mod microfacet;
+pub mod piecewise;
 #[cfg(test)]
 pub(crate) mod quadrature;
 pub mod spherical;
