@@ -2,6 +2,7 @@
 
 mod area;
 mod bounds;
+pub mod envmap;
 pub mod rules;
 mod select;
 mod tree;
