@@ -271,3 +271,22 @@ fn aov_images_add_up_to_the_image() {
         "{err}"
     );
 }
+
+/// The bundled environment map is exactly what its generator writes (it is data made by
+/// code: a change to either without the other fails here).
+#[test]
+fn bundled_sky_is_what_its_generator_writes() {
+    let out = scratch("sky").join("sky.exr");
+    let o = std::process::Command::new("python3")
+        .arg(repo("scenes/envmap/make_sky.py"))
+        .arg(&out)
+        .output()
+        .expect("python3");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let made = std::fs::read(&out).unwrap();
+    let bundled = std::fs::read(repo("scenes/envmap/sky.exr")).unwrap();
+    assert!(
+        made == bundled,
+        "scenes/envmap/sky.exr differs from make_sky.py's output"
+    );
+}
