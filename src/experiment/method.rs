@@ -76,6 +76,29 @@ pub struct Method {
 }
 
 impl Method {
+    /// The settings of one render of this method (`spp` samples, `seed`), its sampler's
+    /// configuration checked against a `width` x `height` film.
+    pub fn settings(
+        &self,
+        spp: u32,
+        seed: u64,
+        threads: Option<usize>,
+        film: (u32, u32),
+    ) -> Result<crate::render::RenderSettings, String> {
+        let settings = crate::render::RenderSettings {
+            spp,
+            seed,
+            first_sample: 0,
+            threads,
+            progress: None,
+            sampling: self.sampler.sampling(),
+        };
+        settings
+            .sampler_config(film)
+            .map_err(|e| format!("{} at {spp} spp: {e}", self.label()))?;
+        Ok(settings)
+    }
+
     /// The strategy's stable label, followed by the sampler unless it is the independent
     /// one (so results of experiments from before samplers keep their labels).
     pub fn label(&self) -> String {

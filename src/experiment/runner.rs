@@ -14,7 +14,7 @@ use super::results::{Results, Row, EQUAL_TIME};
 use super::schema::{EqualTimeSpec, Resolved};
 use crate::film;
 use crate::integrator::Strategy;
-use crate::render::{render, RenderOutput, RenderSettings};
+use crate::render::{render, RenderOutput};
 use crate::scene::Scene;
 use serde_json::json;
 use std::io::IsTerminal;
@@ -75,18 +75,10 @@ pub(crate) fn execute(ctx: &Ctx, job: &Job) -> Result<Row, String> {
 
 /// Renders `job` and measures it against the reference.
 pub(crate) fn render_job(ctx: &Ctx, job: &Job) -> Result<(Row, RenderOutput), String> {
-    let settings = RenderSettings {
-        spp: job.spp,
-        seed: job.seed,
-        first_sample: 0,
-        threads: ctx.threads,
-        progress: None,
-        sampling: job.method.sampler.sampling(),
-    };
     let cam = &ctx.scene.camera;
-    settings
-        .sampler_config((cam.width, cam.height))
-        .map_err(|e| format!("{} at {} spp: {e}", job.method.label(), job.spp))?;
+    let settings = job
+        .method
+        .settings(job.spp, job.seed, ctx.threads, (cam.width, cam.height))?;
     let out = render(ctx.scene, job.method.strategy, &settings);
     Ok((
         measure(ctx.reference, ctx.eps, ctx.extra, &ctx.context, job, &out),

@@ -8,7 +8,6 @@ use crate::experiment::runner::Outcome;
 use crate::plot::panels::{write_figure, Panel};
 use directlab_render::aov::render_aov;
 use directlab_render::film::Image;
-use directlab_render::render::RenderSettings;
 
 /// A weight image (values in [0, 1], one per pixel) as grey levels.
 fn weight_panel(img: &Image, title: &str) -> Panel {
@@ -32,17 +31,8 @@ pub(super) fn techniques(o: &Outcome) -> Result<Option<Figure>, String> {
     let exposure = o.exp.exp.figures.exposure.unwrap_or(1.0);
     let mut rows = Vec::new();
     for ((_, name), method) in o.strategies.iter().zip(&o.methods) {
-        let settings = RenderSettings {
-            spp,
-            seed: 0,
-            first_sample: 0,
-            threads: None,
-            progress: None,
-            sampling: method.sampler.sampling(),
-        };
-        settings
-            .sampler_config((scene.camera.width, scene.camera.height))
-            .map_err(|e| format!("{name} at {spp} spp: {e}"))?;
+        let film = (scene.camera.width, scene.camera.height);
+        let settings = method.settings(spp, 0, None, film)?;
         let aov = render_aov(&scene, method.strategy, &settings);
         rows.push(vec![
             panel_of(&aov.light, exposure, &format!("{name}: light part")).fit(PANEL),

@@ -10,7 +10,7 @@
 use crate::film::Image;
 use crate::math::{luminance, Rgb, PI};
 use crate::sampling::piecewise::{
-    compensated, latlong_direction, latlong_pdf_solid_angle, latlong_uv, Piecewise2D,
+    bin, compensated, latlong_direction, latlong_pdf_solid_angle, latlong_uv, Piecewise2D,
 };
 use glam::{Mat3, Vec2, Vec3};
 
@@ -108,9 +108,7 @@ impl EnvMap {
 
     /// The texel seen along the local direction's coordinates `uv`.
     fn texel(&self, uv: Vec2) -> Rgb {
-        let x = ((uv.x * self.width as f32) as usize).min(self.width - 1);
-        let y = ((uv.y * self.height as f32) as usize).min(self.height - 1);
-        self.radiance[y * self.width + x]
+        self.radiance[bin(uv.y, self.height) * self.width + bin(uv.x, self.width)]
     }
 
     /// Radiance arriving from the environment along world direction `d` (unit, pointing

@@ -66,17 +66,22 @@ impl Sums {
 
     /// The sums of `self` and `o` together.
     pub fn plus(&self, o: &Sums) -> Sums {
+        self.combine(o, 1.0)
+    }
+
+    /// `self` + `sign` x `o`, field by field (the counts as integers).
+    fn combine(&self, o: &Sums, sign: f64) -> Sums {
         let mut s = *self;
         for i in 0..3 {
-            s.a[i] += o.a[i];
-            s.sf[i] += o.sf[i];
+            s.a[i] += sign * o.a[i];
+            s.sf[i] += sign * o.sf[i];
             for t in 0..2 {
-                s.b[t][i] += o.b[t][i];
+                s.b[t][i] += sign * o.b[t][i];
             }
         }
-        s.sp[0] += o.sp[0];
-        s.sp[1] += o.sp[1];
-        s.n += o.n;
+        s.sp[0] += sign * o.sp[0];
+        s.sp[1] += sign * o.sp[1];
+        s.n = if sign > 0.0 { s.n + o.n } else { s.n - o.n };
         s
     }
 
@@ -144,21 +149,9 @@ pub fn cross_fitted(folds: &[Sums]) -> [f64; 3] {
     out
 }
 
-/// `total` without fold `k`'s sums (computed as a difference: each fold's complement in one
-/// subtraction rather than K - 1 additions).
+/// `total` without fold `k`'s sums (one subtraction per fold rather than K - 1 additions).
 fn complement(total: &Sums, k: &Sums) -> Sums {
-    let mut s = *total;
-    for i in 0..3 {
-        s.a[i] -= k.a[i];
-        s.sf[i] -= k.sf[i];
-        for t in 0..2 {
-            s.b[t][i] -= k.b[t][i];
-        }
-    }
-    s.sp[0] -= k.sp[0];
-    s.sp[1] -= k.sp[1];
-    s.n -= k.n;
-    s
+    total.combine(k, -1.0)
 }
 
 #[cfg(test)]

@@ -47,7 +47,7 @@ fn inside(i: usize, t: f64, n: usize) -> f32 {
 
 /// The bin of `x` in [0, 1] among `n`.
 #[inline]
-fn bin(x: f32, n: usize) -> usize {
+pub(crate) fn bin(x: f32, n: usize) -> usize {
     ((x * n as f32) as usize).min(n - 1)
 }
 
